@@ -1,0 +1,3 @@
+//! Tesela: a physically based renderer for glTF scenes and Blender.
+
+pub mod scene;

@@ -1,0 +1,268 @@
+//! The renderer's scene description: everything the loaders produce and the renderer consumes.
+//!
+//! All geometry is flattened to **world space** (right-handed, +Y up as in glTF, metres).
+//! Colours are **linear** RGB; radiometric quantities are in watts (W/sr for intensity,
+//! W/m² for irradiance, W/(m² sr) for radiance).
+
+pub mod gltf;
+
+use glam::{Mat4, Vec2, Vec3};
+
+/// A triangle mesh in world space with one material.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub name: String,
+    /// Vertex positions, world space.
+    pub positions: Vec<Vec3>,
+    /// Per-vertex shading normals, world space, unit length (may be empty: then the
+    /// geometric normal is used everywhere).
+    pub normals: Vec<Vec3>,
+    /// Per-vertex texture coordinates (set 0); may be empty.
+    pub uvs: Vec<Vec2>,
+    /// Counter-clockwise triangles (front face by the right-hand rule, after any
+    /// negative-determinant transform has been compensated by the loader).
+    pub indices: Vec<[u32; 3]>,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+}
+
+/// How a texture is sampled at a texel boundary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Wrap {
+    #[default]
+    Repeat,
+    MirroredRepeat,
+    ClampToEdge,
+}
+
+/// A decoded image: 8-bit RGBA, rows top to bottom (as in PNG/JPEG files).
+#[derive(Clone, Debug)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub rgba8: Vec<[u8; 4]>,
+}
+
+/// A texture: an image and how to sample it.
+#[derive(Clone, Debug)]
+pub struct Texture {
+    /// Index into [`Scene::images`].
+    pub image: usize,
+    pub wrap_s: Wrap,
+    pub wrap_t: Wrap,
+    /// Nearest-texel magnification (glTF NEAREST); otherwise bilinear.
+    pub nearest: bool,
+}
+
+/// A material's reference to a texture.
+#[derive(Clone, Copy, Debug)]
+pub struct TexRef {
+    /// Index into [`Scene::textures`].
+    pub texture: usize,
+    /// Which TEXCOORD set (only 0 is loaded; others fall back to 0).
+    pub texcoord: u32,
+}
+
+/// glTF metallic-roughness material with the KHR extensions Tesela understands.
+#[derive(Clone, Debug)]
+pub struct Material {
+    pub name: String,
+    /// Linear base colour factor (RGB); alpha is ignored.
+    pub base_color: Vec3,
+    /// sRGB-encoded base colour texture, multiplied with `base_color`.
+    pub base_color_texture: Option<TexRef>,
+    pub metallic: f32,
+    /// Perceptual roughness in [0, 1] (GGX alpha = roughness²).
+    pub roughness: f32,
+    /// Linear texture: roughness in G, metallic in B.
+    pub metallic_roughness_texture: Option<TexRef>,
+    /// Emitted radiance, W/(m² sr): `emissiveFactor * KHR_materials_emissive_strength`.
+    pub emission: Vec3,
+    /// sRGB-encoded emissive texture, multiplied with `emission`.
+    pub emission_texture: Option<TexRef>,
+    /// Whether emission leaves both faces (glTF `doubleSided`, or `TESELA_emission.two_sided`).
+    pub emission_two_sided: bool,
+    /// `KHR_materials_transmission` factor in [0, 1].
+    pub transmission: f32,
+    /// `KHR_materials_ior` (default 1.5).
+    pub ior: f32,
+    /// `KHR_materials_specular` specularFactor (default 1; 0 = purely Lambertian dielectric).
+    pub specular: f32,
+    /// `KHR_materials_specular` specularColorFactor (linear).
+    pub specular_color: Vec3,
+    /// glTF `doubleSided`.
+    pub double_sided: bool,
+}
+
+impl Default for Material {
+    /// The glTF default material: white, fully metallic, fully rough.
+    fn default() -> Self {
+        Material {
+            name: "default".into(),
+            base_color: Vec3::ONE,
+            base_color_texture: None,
+            metallic: 1.0,
+            roughness: 1.0,
+            metallic_roughness_texture: None,
+            emission: Vec3::ZERO,
+            emission_texture: None,
+            emission_two_sided: false,
+            transmission: 0.0,
+            ior: 1.5,
+            specular: 1.0,
+            specular_color: Vec3::ONE,
+            double_sided: false,
+        }
+    }
+}
+
+impl Material {
+    /// A white Lambertian material (used by built-in scenes and tests).
+    pub fn diffuse(name: &str, color: Vec3) -> Self {
+        Material {
+            name: name.into(),
+            base_color: color,
+            metallic: 0.0,
+            roughness: 1.0,
+            specular: 0.0,
+            ..Default::default()
+        }
+    }
+
+    /// A perfect mirror (metallic 1, roughness 0).
+    pub fn mirror(name: &str, color: Vec3) -> Self {
+        Material {
+            name: name.into(),
+            base_color: color,
+            metallic: 1.0,
+            roughness: 0.0,
+            ..Default::default()
+        }
+    }
+
+    /// An ideal dielectric (transmission 1, roughness 0).
+    pub fn glass(name: &str, ior: f32) -> Self {
+        Material {
+            name: name.into(),
+            base_color: Vec3::ONE,
+            metallic: 0.0,
+            roughness: 0.0,
+            transmission: 1.0,
+            ior,
+            ..Default::default()
+        }
+    }
+
+    /// A black Lambertian emitter of radiance `radiance`.
+    pub fn emitter(name: &str, radiance: Vec3, two_sided: bool) -> Self {
+        Material {
+            emission: radiance,
+            emission_two_sided: two_sided,
+            double_sided: two_sided,
+            ..Material::diffuse(name, Vec3::ZERO)
+        }
+    }
+
+    pub fn is_emissive(&self) -> bool {
+        self.emission.max_element() > 0.0
+    }
+}
+
+/// How a spot light falls off between its inner and outer cone.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SpotFalloff {
+    /// glTF KHR_lights_punctual: `clamp((cos θ - cos_outer) / (cos_inner - cos_outer), 0, 1)²`.
+    Gltf { cos_inner: f32, cos_outer: f32 },
+    /// Cycles: `smoothstep(0, 1, (cos θ - cos_half) / smooth)` with
+    /// `smooth = (1 - cos_half) * blend`; a hard edge when `smooth` is 0.
+    Cycles { cos_half: f32, smooth: f32 },
+}
+
+/// Lights other than emissive meshes (those are found from their materials).
+#[derive(Clone, Debug)]
+pub enum Light {
+    /// Isotropic point light of radiant intensity `intensity` (W/sr).
+    Point { position: Vec3, intensity: Vec3 },
+    /// Spot light: `intensity` (W/sr) on its axis `direction` (unit, pointing away from the light).
+    Spot {
+        position: Vec3,
+        direction: Vec3,
+        intensity: Vec3,
+        falloff: SpotFalloff,
+    },
+    /// Directional light: light travels along `direction` (unit); `irradiance` (W/m²) on a
+    /// surface facing it. `angle` is the angular diameter of the source (radians, 0 = delta).
+    Directional {
+        direction: Vec3,
+        irradiance: Vec3,
+        angle: f32,
+    },
+}
+
+/// Camera projection.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// Vertical field of view in radians.
+    Perspective { yfov: f32 },
+    /// Half-height of the view volume in metres.
+    Orthographic { ymag: f32 },
+}
+
+/// A camera looking down its local -Z with +Y up (glTF convention).
+#[derive(Clone, Copy, Debug)]
+pub struct Camera {
+    pub projection: Projection,
+    /// Camera-to-world transform (rigid; scale is removed by the loader).
+    pub to_world: Mat4,
+    /// The file's aspect ratio (width/height), if it states one.
+    pub aspect: Option<f32>,
+}
+
+/// Render settings a scene file may carry (the add-on's `TESELA_render` extension).
+/// The CLI's options override each of them.
+#[derive(Clone, Debug, Default)]
+pub struct RenderSettings {
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    pub spp: Option<u32>,
+    pub max_depth: Option<u32>,
+    pub seed: Option<u64>,
+    pub integrator: Option<String>,
+}
+
+/// A complete scene.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    pub meshes: Vec<Mesh>,
+    pub materials: Vec<Material>,
+    pub textures: Vec<Texture>,
+    pub images: Vec<Image>,
+    pub lights: Vec<Light>,
+    pub camera: Option<Camera>,
+    /// Constant background radiance seen by rays that leave the scene, W/(m² sr).
+    pub background: Vec3,
+    pub settings: RenderSettings,
+    /// Non-fatal problems found while loading (unknown optional extensions, skipped primitives...).
+    pub warnings: Vec<String>,
+}
+
+impl Scene {
+    /// Axis-aligned bounds of all mesh vertices, or `None` for a scene without geometry.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        let mut any = false;
+        for m in &self.meshes {
+            for p in &m.positions {
+                lo = lo.min(*p);
+                hi = hi.max(*p);
+                any = true;
+            }
+        }
+        any.then_some((lo, hi))
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.meshes.iter().map(|m| m.indices.len()).sum()
+    }
+}
