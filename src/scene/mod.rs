@@ -4,7 +4,10 @@
 //! Colours are **linear** RGB; radiometric quantities are in watts (W/sr for intensity,
 //! W/m² for irradiance, W/(m² sr) for radiance).
 
+pub mod error;
 pub mod gltf;
+
+pub use error::{LoadError, LoadErrorKind};
 
 use glam::{Mat4, Vec2, Vec3};
 

@@ -1,0 +1,538 @@
+//! glTF 2.0 loader (`.gltf` with external or data-URI buffers, and `.glb`).
+//!
+//! The `gltf` crate parses the JSON into its typed document; everything else is done here
+//! with explicit checks, so that no input can make the loader panic, hang or allocate
+//! without bound: buffers and images are resolved by [`uri`] (data URIs, the GLB BIN
+//! chunk, bufferViews and files inside the scene's folder only), accessors are read by
+//! [`accessor`], and the node tree is walked iteratively with a visited set.
+//!
+//! Extensions read from the raw JSON: `KHR_lights_punctual`, `KHR_materials_*`
+//! (emissive_strength, ior, transmission, specular), `KHR_mesh_quantization` (accessor
+//! types), and Tesela's own `TESELA_light`, `TESELA_world`, `TESELA_emission`,
+//! `TESELA_render` (see `docs/extensions.md`).
+
+mod accessor;
+mod container;
+mod lights;
+mod material;
+mod mesh;
+mod uri;
+
+use std::borrow::Cow;
+use std::collections::{HashMap, HashSet};
+use std::path::Path;
+use std::rc::Rc;
+
+use ::gltf::json;
+use glam::{Mat3, Mat4, Quat, Vec3, Vec4};
+use serde_json::Value;
+
+use crate::scene::error::{LoadError, LoadErrorKind};
+use crate::scene::{Camera, Projection, RenderSettings, Scene};
+
+/// Output limits: a scene beyond them is refused rather than exhausting memory.
+const MAX_TRIANGLES: usize = 1 << 26;
+const MAX_VERTICES: usize = 1 << 26;
+
+/// Extensions that may appear in `extensionsRequired`.
+const SUPPORTED_REQUIRED: &[&str] = &[
+    "KHR_mesh_quantization",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_transmission",
+    "KHR_materials_specular",
+    "KHR_lights_punctual",
+    "KHR_texture_transform",
+    "TESELA_light",
+    "TESELA_world",
+    "TESELA_emission",
+    "TESELA_render",
+];
+
+/// Extensions that are used without a warning.
+const UNDERSTOOD: &[&str] = &[
+    "KHR_mesh_quantization",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_transmission",
+    "KHR_materials_specular",
+    "KHR_lights_punctual",
+    "TESELA_light",
+    "TESELA_world",
+    "TESELA_emission",
+    "TESELA_render",
+];
+
+/// Loads a `.gltf` or `.glb` file. External files are resolved relative to its folder
+/// and must lie inside it.
+pub fn load(path: &Path) -> Result<Scene, LoadError> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| {
+        LoadError::new(LoadErrorKind::Io, format!("cannot read the file: {e}")).in_file(&name)
+    })?;
+    let base = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    load_from_slice(&bytes, Some(base), &name)
+}
+
+/// Loads glTF JSON or GLB bytes. `base_dir` is the folder external URIs are resolved in
+/// (`None` refuses every external file); `name` names the input in messages.
+pub fn load_from_slice(
+    bytes: &[u8],
+    base_dir: Option<&Path>,
+    name: &str,
+) -> Result<Scene, LoadError> {
+    load_inner(bytes, base_dir).map_err(|e| e.in_file(name))
+}
+
+fn invalid(msg: String) -> LoadError {
+    LoadError::new(LoadErrorKind::Invalid, msg)
+}
+
+fn load_inner(bytes: &[u8], base_dir: Option<&Path>) -> Result<Scene, LoadError> {
+    let c = container::split(bytes)?;
+    let raw: Value = serde_json::from_slice(c.json)
+        .map_err(|e| LoadError::new(LoadErrorKind::Format, format!("invalid JSON: {e}")))?;
+    if !raw.is_object() {
+        return Err(LoadError::new(
+            LoadErrorKind::Format,
+            "not a glTF file: the JSON is not an object",
+        ));
+    }
+    let root: json::Root = serde_json::from_slice(c.json).map_err(|e| {
+        LoadError::new(
+            LoadErrorKind::Format,
+            format!("not a valid glTF 2.0 document: {e}"),
+        )
+    })?;
+    let version = root.asset.version.trim();
+    if !version.starts_with("2.") && version != "2" {
+        return Err(LoadError::new(
+            LoadErrorKind::Unsupported,
+            format!("unsupported glTF version `{version}` (asset.version); only 2.x is supported"),
+        ));
+    }
+    if let Some(unsupported) = root
+        .extensions_required
+        .iter()
+        .find(|e| !SUPPORTED_REQUIRED.contains(&e.as_str()))
+    {
+        return Err(LoadError::new(
+            LoadErrorKind::Unsupported,
+            format!("unsupported required extension `{unsupported}` (extensionsRequired)"),
+        ));
+    }
+    let mut warnings = Vec::new();
+    let mut seen = HashSet::new();
+    for ext in root.extensions_used.iter() {
+        if !UNDERSTOOD.contains(&ext.as_str()) && seen.insert(ext.clone()) {
+            warnings.push(format!(
+                "extension `{ext}` is not supported and is ignored (extensionsUsed)"
+            ));
+        }
+    }
+    let buffers = resolve_buffers(&root, c.bin, base_dir)?;
+    let buffer_refs: Vec<&[u8]> = buffers.iter().map(|b| &b[..]).collect();
+    let mut loader = Loader {
+        root: &root,
+        raw: &raw,
+        base_dir,
+        reader: accessor::Reader {
+            root: &root,
+            buffers: &buffer_refs,
+        },
+        scene: Scene {
+            warnings,
+            ..Default::default()
+        },
+        materials: HashMap::new(),
+        default_material: None,
+        textures: HashMap::new(),
+        images: HashMap::new(),
+        prim_cache: HashMap::new(),
+        warned: HashSet::new(),
+        tri_total: 0,
+        vert_total: 0,
+    };
+    loader.root_extensions()?;
+    loader.walk()?;
+    Ok(loader.scene)
+}
+
+/// Fetches every buffer, trimmed to its `byteLength`.
+fn resolve_buffers<'a>(
+    root: &json::Root,
+    bin: Option<&'a [u8]>,
+    base_dir: Option<&Path>,
+) -> Result<Vec<Cow<'a, [u8]>>, LoadError> {
+    let mut out = Vec::with_capacity(root.buffers.len());
+    for (i, b) in root.buffers.iter().enumerate() {
+        let want = b.byte_length.0;
+        let data: Cow<'a, [u8]> = match &b.uri {
+            None => {
+                if i != 0 {
+                    return Err(invalid(format!(
+                        "buffer {i} has no uri (only buffer 0 may refer to the GLB BIN chunk)"
+                    )));
+                }
+                let bin = bin.ok_or_else(|| {
+                    invalid("buffer 0 has no uri and there is no GLB BIN chunk".to_string())
+                })?;
+                if (bin.len() as u64) < want {
+                    return Err(invalid(format!(
+                        "buffer 0: the GLB BIN chunk is {} bytes, shorter than byteLength {want}",
+                        bin.len()
+                    )));
+                }
+                Cow::Borrowed(bin)
+            }
+            Some(u) => {
+                let shown = short_uri(u);
+                let ctx = |e: LoadError| {
+                    LoadError::new(e.kind, format!("buffer {i} (`{shown}`): {}", e.message))
+                };
+                match uri::resolve(u, base_dir).map_err(ctx)? {
+                    uri::Target::Data { bytes, .. } => {
+                        if (bytes.len() as u64) < want {
+                            return Err(invalid(format!(
+                                "buffer {i}: data URI holds {} bytes, fewer than byteLength {want}",
+                                bytes.len()
+                            )));
+                        }
+                        Cow::Owned(bytes)
+                    }
+                    uri::Target::File(path) => {
+                        // resolve() returned File only with a base directory.
+                        let base = base_dir.unwrap_or(Path::new("."));
+                        Cow::Owned(uri::read_file(&path, base, u, Some(want)).map_err(ctx)?)
+                    }
+                }
+            }
+        };
+        // `want <= data.len()` was checked above.
+        let data = match data {
+            Cow::Borrowed(s) => Cow::Borrowed(&s[..want as usize]),
+            Cow::Owned(mut v) => {
+                v.truncate(want as usize);
+                Cow::Owned(v)
+            }
+        };
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// A URI shortened for messages (data URIs can be megabytes long).
+fn short_uri(u: &str) -> String {
+    if u.len() > 64 {
+        let mut end = 48;
+        while !u.is_char_boundary(end) {
+            end -= 1;
+        }
+        format!("{}...", &u[..end])
+    } else {
+        u.to_string()
+    }
+}
+
+/// Triangulated primitive data in the mesh's local space.
+pub(crate) struct LocalPrim {
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub uvs: Vec<glam::Vec2>,
+    pub tris: Vec<[u32; 3]>,
+}
+
+pub(crate) struct Loader<'a> {
+    pub root: &'a json::Root,
+    pub raw: &'a Value,
+    pub base_dir: Option<&'a Path>,
+    pub reader: accessor::Reader<'a>,
+    pub scene: Scene,
+    /// glTF material index -> scene material index.
+    pub materials: HashMap<usize, usize>,
+    pub default_material: Option<usize>,
+    /// glTF texture index -> scene texture index.
+    pub textures: HashMap<usize, usize>,
+    /// glTF image index -> scene image index.
+    pub images: HashMap<usize, usize>,
+    /// (mesh, primitive) -> local data, for meshes instanced with their default weights.
+    pub prim_cache: HashMap<(usize, usize), Option<Rc<LocalPrim>>>,
+    pub warned: HashSet<String>,
+    /// Triangles and vertices emitted so far (checked against the limits).
+    pub tri_total: usize,
+    pub vert_total: usize,
+}
+
+/// `raw[key]` as an object member, if present.
+pub(crate) fn member<'v>(v: &'v Value, key: &str) -> Option<&'v Value> {
+    v.as_object().and_then(|o| o.get(key))
+}
+
+/// The raw JSON of extension `ext` on `v`.
+pub(crate) fn extension<'v>(v: &'v Value, ext: &str) -> Option<&'v Value> {
+    member(v, "extensions").and_then(|e| member(e, ext))
+}
+
+/// `v[key]` as a number.
+pub(crate) fn num(v: &Value, key: &str) -> Option<f64> {
+    member(v, key).and_then(Value::as_f64)
+}
+
+/// `v[key]` as `[r, g, b]`.
+pub(crate) fn rgb(v: &Value, key: &str) -> Option<Vec3> {
+    let a = member(v, key)?.as_array()?;
+    if a.len() < 3 {
+        return None;
+    }
+    let c = |i: usize| a[i].as_f64().map(|x| x as f32);
+    Some(Vec3::new(c(0)?, c(1)?, c(2)?))
+}
+
+impl<'a> Loader<'a> {
+    pub(crate) fn warn_once(&mut self, msg: String) {
+        if self.warned.insert(msg.clone()) {
+            self.scene.warnings.push(msg);
+        }
+    }
+
+    /// `nodes[i]` in the raw JSON.
+    pub(crate) fn raw_item(&self, array: &str, i: usize) -> &'a Value {
+        static NULL: Value = Value::Null;
+        member(self.raw, array)
+            .and_then(|a| a.as_array())
+            .and_then(|a| a.get(i))
+            .unwrap_or(&NULL)
+    }
+
+    fn root_extensions(&mut self) -> Result<(), LoadError> {
+        if let Some(w) = extension(self.raw, "TESELA_world") {
+            let color = rgb(w, "color").unwrap_or(Vec3::ZERO);
+            let strength = num(w, "strength").unwrap_or(1.0) as f32;
+            let bg = color * strength;
+            if bg.is_finite() && bg.min_element() >= 0.0 {
+                self.scene.background = bg;
+            } else {
+                self.scene
+                    .warnings
+                    .push("TESELA_world: invalid color or strength, ignored".into());
+            }
+        }
+        if let Some(r) = extension(self.raw, "TESELA_render") {
+            let mut s = RenderSettings::default();
+            let u32_of = |k: &str| {
+                member(r, k)
+                    .and_then(Value::as_u64)
+                    .and_then(|v| u32::try_from(v).ok())
+            };
+            s.width = u32_of("width").filter(|&v| v > 0);
+            s.height = u32_of("height").filter(|&v| v > 0);
+            s.spp = u32_of("spp").filter(|&v| v > 0);
+            s.max_depth = u32_of("max_depth");
+            s.seed = member(r, "seed").and_then(Value::as_u64);
+            s.integrator = member(r, "integrator")
+                .and_then(Value::as_str)
+                .map(str::to_string);
+            self.scene.settings = s;
+        }
+        Ok(())
+    }
+
+    /// The root nodes of the scene to render.
+    fn roots(&self) -> Result<Vec<usize>, LoadError> {
+        let root = self.root;
+        let scene = match root.scene {
+            Some(s) => Some(root.scenes.get(s.value()).ok_or_else(|| {
+                invalid(format!(
+                    "scene {} (the default `scene`) does not exist (the file has {})",
+                    s.value(),
+                    root.scenes.len()
+                ))
+            })?),
+            None => root.scenes.first(),
+        };
+        if let Some(scene) = scene {
+            return Ok(scene.nodes.iter().map(|n| n.value()).collect());
+        }
+        // No scenes: every node that is nobody's child.
+        let mut is_child = vec![false; root.nodes.len()];
+        for n in &root.nodes {
+            for c in n.children.iter().flatten() {
+                if let Some(f) = is_child.get_mut(c.value()) {
+                    *f = true;
+                }
+            }
+        }
+        Ok((0..root.nodes.len()).filter(|&i| !is_child[i]).collect())
+    }
+
+    /// Walks the node tree depth first (pre-order, children in order), iteratively.
+    fn walk(&mut self) -> Result<(), LoadError> {
+        let roots = self.roots()?;
+        let n = self.root.nodes.len();
+        let mut visited = vec![false; n];
+        let mut stack: Vec<(usize, Mat4)> =
+            roots.iter().rev().map(|&r| (r, Mat4::IDENTITY)).collect();
+        while let Some((ni, parent)) = stack.pop() {
+            let node =
+                self.root.nodes.get(ni).ok_or_else(|| {
+                    invalid(format!("node {ni} does not exist (the file has {n})"))
+                })?;
+            if visited[ni] {
+                return Err(invalid(format!(
+                    "node {ni} is reached twice (a cycle, or a node with two parents)"
+                )));
+            }
+            visited[ni] = true;
+            let world = parent * local_transform(node, ni)?;
+            if !world.is_finite() {
+                return Err(invalid(format!(
+                    "node {ni}: its world transform is not finite"
+                )));
+            }
+            if let Some(ci) = node.camera
+                && self.scene.camera.is_none()
+            {
+                self.scene.camera = Some(self.camera(ci.value(), ni, world)?);
+            }
+            if let Some(mi) = node.mesh {
+                self.instance_mesh(ni, mi.value(), world)?;
+            }
+            self.node_lights(ni, world)?;
+            for c in node.children.iter().flatten().rev() {
+                stack.push((c.value(), world));
+            }
+        }
+        Ok(())
+    }
+
+    fn camera(&self, ci: usize, ni: usize, world: Mat4) -> Result<Camera, LoadError> {
+        let cam = self.root.cameras.get(ci).ok_or_else(|| {
+            invalid(format!(
+                "node {ni}: camera {ci} does not exist (the file has {})",
+                self.root.cameras.len()
+            ))
+        })?;
+        use json::camera::Type as T;
+        use json::validation::Checked;
+        let (projection, aspect) = match (&cam.type_, &cam.perspective, &cam.orthographic) {
+            (Checked::Valid(T::Perspective), Some(p), _) => {
+                let y = p.yfov;
+                if !(y.is_finite() && y > 0.0 && y < std::f32::consts::PI) {
+                    return Err(invalid(format!(
+                        "camera {ci}: perspective yfov {y} is not in (0, pi)"
+                    )));
+                }
+                let aspect = p.aspect_ratio.filter(|a| a.is_finite() && *a > 0.0);
+                (Projection::Perspective { yfov: y }, aspect)
+            }
+            (Checked::Valid(T::Orthographic), _, Some(o)) => {
+                let m = o.ymag.abs();
+                if !(m.is_finite() && m > 0.0) {
+                    return Err(invalid(format!(
+                        "camera {ci}: orthographic ymag {} is zero or not finite",
+                        o.ymag
+                    )));
+                }
+                let x = o.xmag.abs();
+                let aspect = (x.is_finite() && x > 0.0).then_some(x / m);
+                (Projection::Orthographic { ymag: m }, aspect)
+            }
+            (Checked::Valid(T::Perspective), None, _) => {
+                return Err(invalid(format!(
+                    "camera {ci}: type perspective without a `perspective` object"
+                )));
+            }
+            (Checked::Valid(T::Orthographic), _, None) => {
+                return Err(invalid(format!(
+                    "camera {ci}: type orthographic without an `orthographic` object"
+                )));
+            }
+            (Checked::Invalid, _, _) => {
+                return Err(invalid(format!("camera {ci}: invalid type")));
+            }
+        };
+        let to_world = orthonormalize(world).ok_or_else(|| {
+            invalid(format!(
+                "node {ni}: camera transform is degenerate (zero scale)"
+            ))
+        })?;
+        Ok(Camera {
+            projection,
+            to_world,
+            aspect,
+        })
+    }
+}
+
+/// The node's local transform (matrix, or T * R * S).
+fn local_transform(node: &json::Node, ni: usize) -> Result<Mat4, LoadError> {
+    let m = if let Some(m) = node.matrix {
+        Mat4::from_cols_array(&m)
+    } else {
+        let t = node.translation.map(Vec3::from_array).unwrap_or(Vec3::ZERO);
+        let s = node.scale.map(Vec3::from_array).unwrap_or(Vec3::ONE);
+        let r = match &node.rotation {
+            Some(q) => {
+                let q = Quat::from_array(q.0);
+                let len = q.length();
+                if !(len.is_finite() && len > 1e-12) {
+                    return Err(invalid(format!(
+                        "node {ni}: rotation {:?} is not a valid quaternion",
+                        q.to_array()
+                    )));
+                }
+                q / len
+            }
+            None => Quat::IDENTITY,
+        };
+        Mat4::from_scale_rotation_translation(s, r, t)
+    };
+    if !m.is_finite() {
+        return Err(invalid(format!("node {ni}: transform is not finite")));
+    }
+    Ok(m)
+}
+
+/// Removes scale (and shear) from a transform, keeping position and orientation: the
+/// result is rigid and right-handed, looking down the original -Z with +Y up.
+pub(crate) fn orthonormalize(m: Mat4) -> Option<Mat4> {
+    let y0 = m.y_axis.truncate();
+    let z = m.z_axis.truncate().try_normalize()?;
+    let x = y0.cross(z).try_normalize()?;
+    let y = z.cross(x);
+    Some(Mat4::from_cols(
+        x.extend(0.0),
+        y.extend(0.0),
+        z.extend(0.0),
+        Vec4::new(m.w_axis.x, m.w_axis.y, m.w_axis.z, 1.0),
+    ))
+}
+
+/// The matrix that transforms normals (inverse transpose of the linear part).
+pub(crate) fn normal_matrix(m: Mat4) -> Option<Mat3> {
+    let l = Mat3::from_mat4(m);
+    let det = l.determinant();
+    (det.is_finite() && det != 0.0).then(|| l.inverse().transpose())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn orthonormalize_removes_scale_keeps_orientation() {
+        let m = Mat4::from_scale_rotation_translation(
+            Vec3::new(2.0, 3.0, 0.5),
+            Quat::from_rotation_y(0.7),
+            Vec3::new(1.0, 2.0, 3.0),
+        );
+        let o = orthonormalize(m).unwrap();
+        let r =
+            Mat4::from_rotation_translation(Quat::from_rotation_y(0.7), Vec3::new(1.0, 2.0, 3.0));
+        assert!(o.abs_diff_eq(r, 1e-5), "{o:?}");
+        assert!(orthonormalize(Mat4::from_scale(Vec3::new(1.0, 1.0, 0.0))).is_none());
+    }
+}
