@@ -1,0 +1,371 @@
+# SPDX-License-Identifier: MIT
+"""The Tesela RenderEngine: export -> renderer subprocess -> tiles into the result."""
+
+import collections
+import os
+import queue
+import shutil
+import signal
+import subprocess
+import tempfile
+import threading
+import time
+
+import bpy
+import numpy as np
+
+from . import compat, export, preferences, protocol
+
+POLL_SECONDS = 0.03        # how often render() looks at the queue and test_break()
+PUSH_SECONDS = 0.25        # how often the render result is refreshed
+STDERR_TAIL_BYTES = 64 * 1024
+STOP_GRACE_SECONDS = 0.15  # stdin closed -> SIGTERM -> SIGKILL, each this long
+
+
+class StderrTail:
+    """Drains a pipe in a thread, keeping only the last `limit` bytes."""
+
+    def __init__(self, pipe, limit=STDERR_TAIL_BYTES):
+        self.pipe = pipe
+        self.limit = limit
+        self.chunks = collections.deque()
+        self.size = 0
+        self.total = 0
+        self.lock = threading.Lock()
+        self.thread = threading.Thread(target=self._run, name="tesela-stderr", daemon=True)
+        self.thread.start()
+
+    def _run(self):
+        fd = self.pipe.fileno()
+        try:
+            while True:
+                chunk = os.read(fd, 65536)
+                if not chunk:
+                    break
+                with self.lock:
+                    self.chunks.append(chunk)
+                    self.size += len(chunk)
+                    self.total += len(chunk)
+                    while self.size > self.limit and len(self.chunks) > 1:
+                        self.size -= len(self.chunks.popleft())
+        except (OSError, ValueError):
+            pass
+
+    def text(self, max_lines=8):
+        with self.lock:
+            data = b"".join(self.chunks)[-self.limit:]
+        lines = [ln for ln in data.decode("utf-8", errors="replace").splitlines() if ln.strip()]
+        return "\n".join(lines[-max_lines:])
+
+
+def _describe_exit(code):
+    if code is None:
+        return "still running"
+    if code < 0:
+        try:
+            return "killed by signal %s" % signal.Signals(-code).name
+        except ValueError:
+            return "killed by signal %d" % -code
+    return "exit code %d" % code
+
+
+def stop_process(proc, grace=STOP_GRACE_SECONDS):
+    """Close stdin, then SIGTERM, then SIGKILL; always reap. Returns the exit code."""
+    if proc is None:
+        return None
+    try:
+        if proc.stdin is not None and not proc.stdin.closed:
+            proc.stdin.close()
+    except OSError:
+        pass
+    for step in ("wait", "terminate", "kill"):
+        if step == "terminate":
+            try:
+                proc.terminate()
+            except OSError:
+                pass
+        elif step == "kill":
+            try:
+                proc.kill()
+            except OSError:
+                pass
+            return proc.wait()
+        try:
+            return proc.wait(timeout=grace)
+        except subprocess.TimeoutExpired:
+            continue
+    return proc.wait()
+
+
+class RenderSession:
+    """Everything one render owns: temp dir, process, threads. Never shared."""
+
+    def __init__(self):
+        self.tmpdir = None
+        self.proc = None
+        self.reader = None
+        self.stderr = None
+        self.messages = queue.Queue()
+
+    def start(self, args):
+        self.proc = subprocess.Popen(args, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                     stderr=subprocess.PIPE, bufsize=0, close_fds=True,
+                                     cwd=self.tmpdir)
+        self.stderr = StderrTail(self.proc.stderr)
+        self.reader = protocol.start_reader(self.proc.stdout, self.messages.put)
+
+    def close(self):
+        """Stop the process and the threads, remove the temp dir. Idempotent."""
+        code = None
+        if self.proc is not None:
+            code = stop_process(self.proc)
+            if self.reader is not None:
+                self.reader.join(timeout=2.0)
+            if self.stderr is not None:
+                self.stderr.thread.join(timeout=2.0)
+            for pipe in (self.proc.stdout, self.proc.stderr):
+                try:
+                    if pipe is not None:
+                        pipe.close()
+                except OSError:
+                    pass
+        if self.tmpdir is not None:
+            shutil.rmtree(self.tmpdir, ignore_errors=True)
+            self.tmpdir = None
+        return code
+
+
+def renderer_args(binary, gltf, settings, width, height, region):
+    args = [binary, "render", gltf, "--pipe",
+            "--integrator", settings.integrator,
+            "--spp", str(settings.samples),
+            "--max-depth", str(settings.max_depth),
+            "--width", str(width), "--height", str(height),
+            "--seed", str(settings.seed)]
+    if settings.threads > 0:
+        args += ["--threads", str(settings.threads)]
+    if region is not None:
+        args += ["--region"] + [str(v) for v in region]
+    return args
+
+
+class TeselaRenderEngine(bpy.types.RenderEngine):
+    bl_idname = "TESELA"
+    bl_label = "Tesela"
+    bl_use_preview = False
+    bl_use_postprocess = True
+    bl_use_shading_nodes_custom = False
+    bl_use_eevee_viewport = True
+
+    def __init__(self, *args, **kwargs):
+        # Blender 4.4+ passes arguments here; older versions pass none.
+        super().__init__(*args, **kwargs)
+
+    # -- helpers --------------------------------------------------------------
+
+    def _fail(self, message):
+        message = "Tesela: " + message
+        print(message)
+        self.report({"ERROR"}, message)
+        if hasattr(self, "error_set"):
+            try:
+                self.error_set(message)
+            except (TypeError, RuntimeError):
+                pass
+
+    # -- render -----------------------------------------------------------------
+
+    def render(self, depsgraph):
+        scene = depsgraph.scene
+        r = scene.render
+        settings = scene.tesela
+        width, height = export.render_size(r)
+        region = export.border_region(r, width, height)
+        rx, ry, rw, rh = region if region is not None else (0, 0, width, height)
+        session = RenderSession()
+        try:
+            self._render(depsgraph, scene, settings, width, height, region, rw, rh, session)
+        finally:
+            session.close()
+
+    def _render(self, depsgraph, scene, settings, width, height, region, rw, rh, session):
+        self.update_stats("", "Tesela | Exporting scene")
+        session.tmpdir = tempfile.mkdtemp(prefix="tesela-render-")
+        gltf = os.path.join(session.tmpdir, "scene.gltf")
+        camera = getattr(self, "camera_override", None) or scene.camera
+        if camera is None:
+            self._fail("the scene has no camera (add one and make it the active camera)")
+            return
+        render_settings = {"width": width, "height": height, "spp": settings.samples,
+                           "max_depth": settings.max_depth, "seed": settings.seed,
+                           "integrator": settings.integrator}
+        t0 = time.monotonic()
+        try:
+            res = export.write_gltf(depsgraph, gltf, width=width, height=height, camera=camera,
+                                    render_settings=render_settings, check_cancel=self.test_break)
+        except export.ExportCancelled:
+            return
+        for w in res.warnings[:20]:
+            print("Tesela: " + w)
+        if self.test_break():
+            return
+        t_export = time.monotonic() - t0
+
+        binary, tried = preferences.find_renderer()
+        if binary is None:
+            self._fail(preferences.not_found_message(tried))
+            return
+        args = renderer_args(binary, gltf, settings, width, height, region)
+        try:
+            session.start(args)
+        except OSError as exc:
+            self._fail("cannot start the renderer %s: %s" % (binary, exc))
+            return
+
+        result = self.begin_result(0, 0, rw, rh)
+        # Full-frame mirror of the result, rows bottom to top (Blender's order).
+        mirror = np.zeros((rh, rw, 4), dtype=np.float32)
+        target = compat.combined_pass(result)
+        if len(target.rect) != rw * rh:
+            # Blender sized the result differently (should not happen): follow it.
+            self._fail("render result is %d pixels, expected %dx%d" % (len(target.rect), rw, rh))
+            self.end_result(result)
+            return
+
+        hello = None
+        done = None
+        error = None
+        error_from_renderer = False
+        cancelled = False
+        dirty = False
+        tiles_done = 0
+        tiles_total = 0
+        spp_now = 0
+        last_push = time.monotonic()
+        t_start = last_push
+
+        def push():
+            compat.pass_rect_set(target, mirror.reshape(-1))
+            self.update_result(result)
+
+        finished = False
+        while not finished:
+            if self.test_break():
+                cancelled = True
+                break
+            try:
+                msg = session.messages.get(timeout=POLL_SECONDS)
+            except queue.Empty:
+                continue
+            batch = [msg]
+            while len(batch) < 4096:
+                try:
+                    batch.append(session.messages.get_nowait())
+                except queue.Empty:
+                    break
+            for msg in batch:
+                if isinstance(msg, protocol.Tile):
+                    if hello is None:
+                        error = "tile before HELLO"
+                        finished = True
+                        break
+                    x, y, w, h = msg.x, msg.y, msg.w, msg.h
+                    if x + w > rw or y + h > rh:
+                        error = "renderer sent a tile outside the image (%d,%d %dx%d in %dx%d)" % (
+                            x, y, w, h, rw, rh)
+                        finished = True
+                        break
+                    mirror[rh - y - h:rh - y, x:x + w] = msg.pixels[::-1]
+                    dirty = True
+                elif isinstance(msg, protocol.Progress):
+                    tiles_done, tiles_total, spp_now = msg.tiles_done, msg.tiles_total, msg.spp
+                    if tiles_total:
+                        self.update_progress(min(1.0, tiles_done / tiles_total))
+                    self.update_stats("", "Tesela | Sample %d/%d | Tile %d/%d | %.1f s" % (
+                        spp_now, settings.samples, tiles_done, tiles_total, msg.elapsed))
+                elif isinstance(msg, protocol.Hello):
+                    hello = msg
+                    if (msg.width, msg.height) != (rw, rh):
+                        error = "renderer announced %dx%d, expected %dx%d" % (
+                            msg.width, msg.height, rw, rh)
+                        finished = True
+                        break
+                    tiles_total = msg.tile_count
+                    self.update_stats("", "Tesela | Sample 0/%d | Tile 0/%d | %.1f s" % (
+                        msg.spp, msg.tile_count, time.monotonic() - t_start))
+                elif isinstance(msg, protocol.Log):
+                    print("Tesela renderer: " + msg.message)
+                    if msg.level >= 2:
+                        self.report({"WARNING"}, "Tesela: " + msg.message)
+                elif isinstance(msg, protocol.Error):
+                    error = msg.message
+                    error_from_renderer = True  # then Eof follows as the renderer exits
+                elif isinstance(msg, protocol.Done):
+                    done = msg.stats
+                elif isinstance(msg, protocol.Failure):
+                    error = msg.message
+                    finished = True
+                    break
+                elif isinstance(msg, protocol.Eof):
+                    finished = True
+                    break
+            now = time.monotonic()
+            if dirty and now - last_push >= PUSH_SECONDS:
+                push()
+                dirty = False
+                last_push = now
+
+        if dirty:
+            push()
+        self.end_result(result)
+
+        if cancelled:
+            session.close()
+            self.update_stats("", "Tesela | Cancelled")
+            return
+        # Normal end or failure: let a finishing renderer exit by itself briefly.
+        code = None
+        if error is None and done is not None:
+            try:
+                code = session.proc.wait(timeout=2.0)
+            except subprocess.TimeoutExpired:
+                code = None
+        if code is None:
+            code = session.close()
+        if error is not None:
+            if session.proc.poll() is None:
+                code = session.close()
+            code = session.proc.returncode
+            if error_from_renderer:
+                msg = "renderer error: " + error
+            else:
+                msg = "%s (renderer %s)" % (error, _describe_exit(code))
+                tail = session.stderr.text() if session.stderr is not None else ""
+                if tail:
+                    msg += "; stderr: " + tail
+            self._fail(msg)
+            return
+        if done is None:
+            tail = session.stderr.text() if session.stderr is not None else ""
+            if hello is None:
+                msg = "the renderer exited without starting the render (%s)" % _describe_exit(code)
+            else:
+                msg = "the renderer stopped mid-render (%s)" % _describe_exit(code)
+            if tail:
+                msg += ": " + tail
+            self._fail(msg)
+            return
+        if code not in (0, None):
+            self.report({"WARNING"}, "Tesela: renderer finished but exited with %s" % _describe_exit(code))
+        secs = done.get("seconds", time.monotonic() - t_start)
+        self.update_stats("", "Tesela | Sample %d/%d | Tile %d/%d | %.1f s (export %.2f s)" % (
+            spp_now or settings.samples, settings.samples, tiles_done, tiles_total, secs, t_export))
+        self.update_progress(1.0)
+
+
+def register():
+    bpy.utils.register_class(TeselaRenderEngine)
+
+
+def unregister():
+    bpy.utils.unregister_class(TeselaRenderEngine)

@@ -1,0 +1,117 @@
+# SPDX-License-Identifier: MIT
+"""Render panel, reuse of Blender's own panels, and the File > Export entry."""
+
+import bpy
+from bpy.props import BoolProperty, StringProperty
+from bpy_extras.io_utils import ExportHelper
+
+from . import export, preferences
+
+ENGINE = "TESELA"
+
+# Engine-specific panels worth sharing (they draw node-based surfaces, lights, worlds).
+_EXTRA_PANELS = (
+    "EEVEE_MATERIAL_PT_context_material", "EEVEE_MATERIAL_PT_surface",
+    "EEVEE_WORLD_PT_surface", "DATA_PT_EEVEE_light", "NODE_DATA_PT_EEVEE_light",
+    "DATA_PT_spot", "DATA_PT_area",
+)
+# Generic ("BLENDER_RENDER") panels that would duplicate or mislead.
+_SKIP_PANELS = ("DATA_PT_light", "NODE_DATA_PT_light")
+
+
+def _compat_panels():
+    for name in dir(bpy.types):
+        cls = getattr(bpy.types, name, None)
+        engines = getattr(cls, "COMPAT_ENGINES", None)
+        if not isinstance(engines, set):
+            continue
+        if "lightprobe" in name.lower() or name in _SKIP_PANELS:
+            continue
+        if "BLENDER_RENDER" in engines or name in _EXTRA_PANELS:
+            yield cls
+
+
+class TESELA_PT_render(bpy.types.Panel):
+    bl_label = "Tesela"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+    COMPAT_ENGINES = {ENGINE}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        s = context.scene.tesela
+        col = layout.column()
+        col.prop(s, "integrator")
+        col.prop(s, "samples")
+        col.prop(s, "max_depth")
+        col.prop(s, "seed")
+        col.prop(s, "threads")
+        path, tried = preferences.find_renderer(context)
+        if path is None:
+            box = layout.box()
+            box.label(text="Renderer binary not found", icon="ERROR")
+            box.label(text="Set it in Preferences > Add-ons > Tesela")
+
+
+class TESELA_OT_export_gltf(bpy.types.Operator, ExportHelper):
+    """Export the evaluated scene as Tesela glTF (.gltf + .bin) for the command line renderer"""
+    bl_idname = "export_scene.tesela_gltf"
+    bl_label = "Export Tesela glTF"
+    bl_options = {"PRESET"}
+
+    filename_ext = ".gltf"
+    filter_glob: StringProperty(default="*.gltf", options={"HIDDEN"})
+    use_selection: BoolProperty(name="Selected Objects Only", default=False)
+
+    def execute(self, context):
+        depsgraph = context.evaluated_depsgraph_get()
+        scene = depsgraph.scene
+        width, height = export.render_size(scene.render)
+        s = scene.tesela
+        settings = {"width": width, "height": height, "spp": s.samples, "max_depth": s.max_depth,
+                    "seed": s.seed, "integrator": s.integrator}
+        selection = None
+        if self.use_selection:
+            selection = {o.name for o in context.selected_objects}
+            if scene.camera is not None:
+                selection.add(scene.camera.name)
+        camera = scene.camera.evaluated_get(depsgraph) if scene.camera is not None else None
+        res = export.write_gltf(depsgraph, self.filepath, width=width, height=height,
+                                camera=camera, render_settings=settings, selection=selection)
+        for w in res.warnings[:20]:
+            self.report({"WARNING"}, w)
+        self.report({"INFO"}, "Tesela: wrote %s (%d triangles)" % (self.filepath, res.triangles))
+        return {"FINISHED"}
+
+
+def _menu_export(self, context):
+    self.layout.operator(TESELA_OT_export_gltf.bl_idname, text="Tesela glTF (.gltf)")
+
+
+_added = []  # panels we added the engine to (registration state, not render state)
+
+
+def register():
+    bpy.utils.register_class(TESELA_PT_render)
+    bpy.utils.register_class(TESELA_OT_export_gltf)
+    bpy.types.TOPBAR_MT_file_export.append(_menu_export)
+    for cls in _compat_panels():
+        if ENGINE not in cls.COMPAT_ENGINES:
+            cls.COMPAT_ENGINES.add(ENGINE)
+            _added.append(cls)
+
+
+def unregister():
+    while _added:
+        cls = _added.pop()
+        cls.COMPAT_ENGINES.discard(ENGINE)
+    bpy.types.TOPBAR_MT_file_export.remove(_menu_export)
+    bpy.utils.unregister_class(TESELA_OT_export_gltf)
+    bpy.utils.unregister_class(TESELA_PT_render)
