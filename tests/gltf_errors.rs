@@ -66,11 +66,11 @@ fn bytes(v: &Value) -> Vec<u8> {
 
 fn glb(json: &[u8], bin: &[u8]) -> Vec<u8> {
     let mut j = json.to_vec();
-    while j.len() % 4 != 0 {
+    while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
     let mut b = bin.to_vec();
-    while b.len() % 4 != 0 {
+    while !b.len().is_multiple_of(4) {
         b.push(0);
     }
     let mut out = b"glTF".to_vec();

@@ -561,7 +561,7 @@ mod tests {
 
     #[test]
     fn bounds_are_checked() {
-        let buf = vec![0u8; 24];
+        let buf = [0u8; 24];
         let r = doc(
             r#"[{"buffer":0,"byteLength":24},{"buffer":0,"byteOffset":16,"byteLength":16},
                 {"buffer":0,"byteLength":24,"byteStride":8}]"#,

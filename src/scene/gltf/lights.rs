@@ -61,6 +61,15 @@ fn valid_color(c: Vec3) -> bool {
 }
 
 impl<'a> Loader<'a> {
+    /// Whether the file was written by Blender's own glTF exporter.
+    fn written_by_blender_exporter(&self) -> bool {
+        self.root
+            .asset
+            .generator
+            .as_deref()
+            .is_some_and(|g| g.starts_with("Khronos glTF Blender I/O"))
+    }
+
     pub(crate) fn node_lights(&mut self, ni: usize, world: Mat4) -> Result<(), LoadError> {
         let raw_node = self.raw_item("nodes", ni);
         if let Some(t) = extension(raw_node, "TESELA_light") {
@@ -110,14 +119,29 @@ impl<'a> Loader<'a> {
                 let inner =
                     (num(spot, "innerConeAngle").unwrap_or(0.0) as f32).clamp(0.0, outer * 0.9999);
                 let inner = if inner.is_finite() { inner } else { 0.0 };
+                let falloff = if self.written_by_blender_exporter() {
+                    // Blender's exporter writes outer = size/2 and inner = outer·(1 - blend);
+                    // Cycles' smoothstep in cos-space is recovered from them
+                    // (docs/blender-units.md). inner == outer (blend 0) is a hard edge.
+                    let raw_inner = num(spot, "innerConeAngle").unwrap_or(0.0) as f32;
+                    let blend = (1.0 - raw_inner / outer).clamp(0.0, 1.0);
+                    let blend = if blend.is_finite() { blend } else { 0.0 };
+                    let cos_half = outer.cos();
+                    SpotFalloff::Cycles {
+                        cos_half,
+                        smooth: (1.0 - cos_half) * blend,
+                    }
+                } else {
+                    SpotFalloff::Gltf {
+                        cos_inner: inner.cos(),
+                        cos_outer: outer.cos(),
+                    }
+                };
                 self.scene.lights.push(Light::Spot {
                     position,
                     direction,
                     intensity: radiometric,
-                    falloff: SpotFalloff::Gltf {
-                        cos_inner: inner.cos(),
-                        cos_outer: outer.cos(),
-                    },
+                    falloff,
                 })
             }
             ("directional", Some(direction)) => self.scene.lights.push(Light::Directional {

@@ -14,7 +14,7 @@ use crate::scene::{Image, Material, TexRef, Texture, Wrap};
 /// Largest accepted image side, in pixels.
 const MAX_IMAGE_SIDE: u32 = 16384;
 /// Largest decoder allocation for one image.
-const MAX_IMAGE_ALLOC: u64 = 1 << 30;
+const MAX_IMAGE_ALLOC: u64 = 512 << 20;
 
 /// Decodes PNG or JPEG bytes into RGBA8, rows top to bottom.
 pub(crate) fn decode_image(bytes: &[u8]) -> Result<Image, String> {

@@ -44,13 +44,13 @@ pub(crate) fn triangulate(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
     }
 }
 
+/// World-space positions, normals (possibly empty) and triangles.
+pub(crate) type WorldPrim = (Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>);
+
 /// Transforms local primitive data to world space. A negative determinant reverses the
 /// winding so that front faces stay front. Normals go through the inverse transpose; if
 /// any is zero or not finite, the primitive's normals are dropped.
-pub(crate) fn to_world(
-    local: &LocalPrim,
-    m: Mat4,
-) -> Option<(Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>)> {
+pub(crate) fn to_world(local: &LocalPrim, m: Mat4) -> Option<WorldPrim> {
     let positions: Vec<Vec3> = local
         .positions
         .iter()

@@ -18,6 +18,9 @@ mod material;
 mod mesh;
 mod uri;
 
+#[cfg(test)]
+mod tests_load;
+
 use std::borrow::Cow;
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
@@ -31,8 +34,8 @@ use crate::scene::error::{LoadError, LoadErrorKind};
 use crate::scene::{Camera, Projection, RenderSettings, Scene};
 
 /// Output limits: a scene beyond them is refused rather than exhausting memory.
-const MAX_TRIANGLES: usize = 1 << 26;
-const MAX_VERTICES: usize = 1 << 26;
+const MAX_TRIANGLES: usize = 1 << 25;
+const MAX_VERTICES: usize = 1 << 25;
 
 /// Extensions that may appear in `extensionsRequired`.
 const SUPPORTED_REQUIRED: &[&str] = &[
@@ -49,9 +52,11 @@ const SUPPORTED_REQUIRED: &[&str] = &[
     "TESELA_render",
 ];
 
-/// Extensions that are used without a warning.
+/// Extensions that are used without a warning (`KHR_texture_transform` is accepted but
+/// not applied: a warning says so where a texture uses it).
 const UNDERSTOOD: &[&str] = &[
     "KHR_mesh_quantization",
+    "KHR_texture_transform",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
     "KHR_materials_transmission",

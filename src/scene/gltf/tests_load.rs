@@ -1,0 +1,543 @@
+//! Whole-document tests of the loader: transforms, instancing, normals, cameras, lights and
+//! Tesela's extensions, on small files built in code.
+
+use std::f32::consts::{FRAC_PI_2, PI};
+
+use base64::Engine;
+use glam::{Mat4, Quat, Vec3};
+use serde_json::{Value, json};
+
+use super::load_from_slice;
+use crate::scene::{Light, Projection, Scene, SpotFalloff};
+
+/// Builds the binary part of a test document.
+#[derive(Default)]
+struct Bin {
+    bytes: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Bin {
+    fn add(&mut self, data: &[u8], comp: u32, count: usize, ty: &str, normalized: bool) -> usize {
+        while !self.bytes.len().is_multiple_of(4) {
+            self.bytes.push(0);
+        }
+        self.views.push(json!({
+            "buffer": 0, "byteOffset": self.bytes.len(), "byteLength": data.len()
+        }));
+        self.bytes.extend_from_slice(data);
+        self.accessors.push(json!({
+            "bufferView": self.views.len() - 1, "componentType": comp, "count": count,
+            "type": ty, "normalized": normalized
+        }));
+        self.accessors.len() - 1
+    }
+
+    fn vec3(&mut self, v: &[[f32; 3]]) -> usize {
+        let b: Vec<u8> = v.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
+        self.add(&b, 5126, v.len(), "VEC3", false)
+    }
+
+    fn indices(&mut self, i: &[u16]) -> usize {
+        let b: Vec<u8> = i.iter().flat_map(|x| x.to_le_bytes()).collect();
+        self.add(&b, 5123, i.len(), "SCALAR", false)
+    }
+
+    /// Completes `doc` with the buffer, views and accessors.
+    fn finish(self, mut doc: Value) -> Vec<u8> {
+        let b64 = base64::engine::general_purpose::STANDARD.encode(&self.bytes);
+        doc["asset"] = json!({ "version": "2.0" });
+        doc["buffers"] = json!([{
+            "byteLength": self.bytes.len(),
+            "uri": format!("data:application/gltf-buffer;base64,{b64}")
+        }]);
+        doc["bufferViews"] = json!(self.views);
+        doc["accessors"] = json!(self.accessors);
+        serde_json::to_vec(&doc).unwrap()
+    }
+}
+
+fn load(bytes: &[u8]) -> Scene {
+    load_from_slice(bytes, None, "test.gltf").unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A unit right triangle in the XY plane facing +Z, with +Z normals, as mesh 0.
+fn triangle_doc(nodes: Value) -> Vec<u8> {
+    let mut b = Bin::default();
+    let p = b.vec3(&[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]]);
+    let n = b.vec3(&[[0., 0., 1.]; 3]);
+    let i = b.indices(&[0, 1, 2]);
+    let roots: Vec<usize> = (0..nodes.as_array().unwrap().len()).collect();
+    b.finish(json!({
+        "scenes": [{ "nodes": roots }],
+        "nodes": nodes,
+        "meshes": [{ "primitives": [{ "attributes": { "POSITION": p, "NORMAL": n }, "indices": i }] }]
+    }))
+}
+
+fn face_normal(s: &Scene, mesh: usize) -> Vec3 {
+    let m = &s.meshes[mesh];
+    let [a, b, c] = m.indices[0].map(|i| m.positions[i as usize]);
+    (b - a).cross(c - a).normalize()
+}
+
+#[test]
+fn instancing_trs_and_nested_matrices() {
+    // Node 0 and node 2 (child of node 1) share mesh 0.
+    let m =
+        Mat4::from_rotation_translation(Quat::from_rotation_x(-FRAC_PI_2), Vec3::new(0., 5., 0.));
+    let s = load(&triangle_doc(
+        json!([{ "mesh": 0, "translation": [10, 0, 0] }]),
+    ));
+    assert_eq!(s.meshes.len(), 1);
+    assert_eq!(s.meshes[0].positions[1], Vec3::new(11., 0., 0.));
+
+    let mut doc: Value = serde_json::from_slice(&triangle_doc(json!([
+        { "mesh": 0, "translation": [10, 0, 0] },
+        { "matrix": m.to_cols_array(), "children": [2] },
+        { "mesh": 0, "scale": [2, 2, 2] }
+    ])))
+    .unwrap();
+    doc["scenes"][0]["nodes"] = json!([0, 1]);
+    let s = load(&serde_json::to_vec(&doc).unwrap());
+    assert_eq!(s.meshes.len(), 2, "one mesh instanced twice");
+    // Second instance: scaled by 2, rotated -90° about X (+Y -> -Z), moved up 5.
+    let p = &s.meshes[1].positions;
+    assert!(p[2].abs_diff_eq(Vec3::new(0., 5., -2.), 1e-5), "{:?}", p);
+    assert!(s.meshes[1].normals[0].abs_diff_eq(Vec3::Y, 1e-5));
+    assert!(face_normal(&s, 1).abs_diff_eq(Vec3::Y, 1e-5));
+    assert_eq!(
+        s.meshes[0].material, s.meshes[1].material,
+        "one default material"
+    );
+    assert_eq!(s.materials.len(), 1);
+}
+
+#[test]
+fn negative_scale_flips_winding_and_normals_follow() {
+    let s = load(&triangle_doc(json!([{ "mesh": 0, "scale": [1, 1, -1] }])));
+    assert!(face_normal(&s, 0).abs_diff_eq(-Vec3::Z, 1e-6));
+    assert!(s.meshes[0].normals[0].abs_diff_eq(-Vec3::Z, 1e-6));
+    let s = load(&triangle_doc(json!([{ "mesh": 0, "scale": [-1, 1, 1] }])));
+    assert_eq!(s.meshes[0].indices[0], [0, 2, 1]);
+    assert!(face_normal(&s, 0).abs_diff_eq(Vec3::Z, 1e-6));
+}
+
+#[test]
+fn zero_normals_are_dropped_and_missing_ones_stay_empty() {
+    let mut b = Bin::default();
+    let p = b.vec3(&[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]]);
+    let n = b.vec3(&[[0., 0., 1.], [0., 0., 0.], [0., 0., 1.]]);
+    let bytes = b.finish(json!({
+        "nodes": [{ "mesh": 0 }, { "mesh": 1 }],
+        "meshes": [
+            { "primitives": [{ "attributes": { "POSITION": p, "NORMAL": n } }] },
+            { "primitives": [{ "attributes": { "POSITION": p } }] }
+        ]
+    }));
+    let s = load(&bytes);
+    assert_eq!(s.meshes.len(), 2);
+    assert!(s.meshes[0].normals.is_empty());
+    assert!(s.meshes[1].normals.is_empty());
+    assert_eq!(s.meshes[0].indices, vec![[0, 1, 2]], "non-indexed");
+}
+
+#[test]
+fn strips_fans_and_empty_primitives() {
+    let mut b = Bin::default();
+    let p = b.vec3(&[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [1., 1., 0.]]);
+    let two = b.vec3(&[[0., 0., 0.], [1., 0., 0.]]);
+    let bytes = b.finish(json!({
+        "nodes": [{ "mesh": 0 }],
+        "meshes": [{ "primitives": [
+            { "attributes": { "POSITION": p }, "mode": 5 },
+            { "attributes": { "POSITION": p }, "mode": 6 },
+            { "attributes": { "POSITION": two }, "mode": 4 },
+            { "attributes": { "POSITION": p }, "mode": 1 }
+        ] }]
+    }));
+    let s = load(&bytes);
+    assert_eq!(
+        s.meshes.len(),
+        2,
+        "the 2-vertex primitive has no triangle and is dropped"
+    );
+    assert_eq!(s.meshes[0].indices, vec![[0, 1, 2], [2, 1, 3]]);
+    assert_eq!(s.meshes[1].indices, vec![[1, 2, 0], [2, 3, 0]]);
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    assert!(s.warnings[0].contains("LINES"));
+}
+
+#[test]
+fn quantized_attributes() {
+    let mut b = Bin::default();
+    // u16 positions (not normalized), i8 normalized normals, u8 normalized uvs.
+    let pos: Vec<u8> = [0u16, 0, 0, 0, 100, 0, 0, 0, 0, 100, 0, 0]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    let p = b.add(&pos, 5123, 3, "VEC3", false);
+    // Each VEC3 of i8 padded to 4 bytes needs byteStride 4.
+    let n = b.add(
+        &[0, 0, 127, 0, 0, 0, 127, 0, 0, 0, 127, 0],
+        5120,
+        3,
+        "VEC3",
+        true,
+    );
+    b.views[1]["byteStride"] = json!(4);
+    // The 6-byte position elements are padded to 8 as well.
+    b.views[0]["byteStride"] = json!(8);
+    let t = b.add(&[0, 255, 255, 255, 0, 0], 5121, 3, "VEC2", true);
+    let bytes = b.finish(json!({
+        "extensionsUsed": ["KHR_mesh_quantization"],
+        "extensionsRequired": ["KHR_mesh_quantization"],
+        "nodes": [{ "mesh": 0, "scale": [0.01, 0.01, 0.01] }],
+        "meshes": [{ "primitives": [{ "attributes": { "POSITION": p, "NORMAL": n, "TEXCOORD_0": t } }] }]
+    }));
+    let s = load(&bytes);
+    let m = &s.meshes[0];
+    assert!(
+        m.positions[1].abs_diff_eq(Vec3::X, 1e-6),
+        "{:?}",
+        m.positions
+    );
+    assert!(m.normals.iter().all(|n| n.abs_diff_eq(Vec3::Z, 1e-6)));
+    assert_eq!(m.uvs[0], glam::Vec2::new(0.0, 1.0));
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+}
+
+#[test]
+fn camera_is_the_first_in_traversal_order_and_rigid() {
+    let rot = Quat::from_rotation_y(0.5);
+    let bytes = serde_json::to_vec(&json!({
+        "asset": { "version": "2.0" },
+        "scenes": [{ "nodes": [0, 2] }],
+        "cameras": [
+            { "type": "perspective", "perspective": { "yfov": 0.5, "znear": 0.1 } },
+            { "type": "orthographic", "orthographic": { "xmag": 3, "ymag": 2, "znear": 0.1, "zfar": 9 } }
+        ],
+        "nodes": [
+            { "children": [1], "scale": [3, 3, 3] },
+            { "camera": 1, "rotation": rot.to_array(), "translation": [1, 2, 3] },
+            { "camera": 0 }
+        ]
+    }))
+    .unwrap();
+    let s = load(&bytes);
+    let c = s.camera.unwrap();
+    assert_eq!(c.projection, Projection::Orthographic { ymag: 2.0 });
+    assert_eq!(c.aspect, Some(1.5));
+    let want = Mat4::from_rotation_translation(rot, Vec3::new(3., 6., 9.));
+    assert!(c.to_world.abs_diff_eq(want, 1e-5), "{:?}", c.to_world);
+}
+
+fn lights_doc(generator: Option<&str>, nodes: Value, lights: Value) -> Vec<u8> {
+    let mut asset = json!({ "version": "2.0" });
+    if let Some(g) = generator {
+        asset["generator"] = json!(g);
+    }
+    let roots: Vec<usize> = (0..nodes.as_array().unwrap().len()).collect();
+    serde_json::to_vec(&json!({
+        "asset": asset,
+        "extensionsUsed": ["KHR_lights_punctual", "TESELA_light"],
+        "extensionsRequired": ["KHR_lights_punctual"],
+        "extensions": { "KHR_lights_punctual": { "lights": lights } },
+        "scenes": [{ "nodes": roots }],
+        "nodes": nodes
+    }))
+    .unwrap()
+}
+
+fn khr(i: usize) -> Value {
+    json!({ "KHR_lights_punctual": { "light": i } })
+}
+
+#[test]
+fn khr_punctual_lights_in_radiometric_units() {
+    let rot = Quat::from_rotation_x(FRAC_PI_2);
+    let bytes = lights_doc(
+        None,
+        json!([
+            { "extensions": khr(0), "translation": [1, 2, 3] },
+            { "extensions": khr(1), "rotation": rot.to_array() },
+            { "extensions": khr(2) }
+        ]),
+        json!([
+            { "type": "point", "intensity": 1366, "color": [1, 0.5, 0.25] },
+            { "type": "spot", "intensity": 683, "spot": { "innerConeAngle": 0.2, "outerConeAngle": 0.5 } },
+            { "type": "directional", "intensity": 2049 }
+        ]),
+    );
+    let s = load(&bytes);
+    assert_eq!(s.lights.len(), 3);
+    match &s.lights[0] {
+        Light::Point {
+            position,
+            intensity,
+        } => {
+            assert_eq!(*position, Vec3::new(1., 2., 3.));
+            assert!(intensity.abs_diff_eq(Vec3::new(2., 1., 0.5), 1e-6));
+        }
+        l => panic!("{l:?}"),
+    }
+    match &s.lights[1] {
+        Light::Spot {
+            direction,
+            intensity,
+            falloff,
+            ..
+        } => {
+            assert!(direction.abs_diff_eq(Vec3::Y, 1e-6), "{direction}");
+            assert!(intensity.abs_diff_eq(Vec3::ONE, 1e-6));
+            assert_eq!(
+                *falloff,
+                SpotFalloff::Gltf {
+                    cos_inner: 0.2f32.cos(),
+                    cos_outer: 0.5f32.cos()
+                }
+            );
+        }
+        l => panic!("{l:?}"),
+    }
+    match &s.lights[2] {
+        Light::Directional {
+            direction,
+            irradiance,
+            angle,
+        } => {
+            assert!(direction.abs_diff_eq(-Vec3::Z, 1e-6));
+            assert!(irradiance.abs_diff_eq(Vec3::splat(3.0), 1e-6));
+            assert_eq!(*angle, 0.0);
+        }
+        l => panic!("{l:?}"),
+    }
+}
+
+#[test]
+fn blender_exported_spots_get_cycles_falloff() {
+    let outer = std::f32::consts::FRAC_PI_6;
+    let inner = outer * (1.0 - 0.3);
+    let bytes = lights_doc(
+        Some("Khronos glTF Blender I/O v5.0.21"),
+        json!([{ "extensions": khr(0) }, { "extensions": khr(1) }]),
+        json!([
+            { "type": "spot", "intensity": 683, "spot": { "innerConeAngle": inner, "outerConeAngle": outer } },
+            { "type": "spot", "intensity": 683, "spot": { "innerConeAngle": outer, "outerConeAngle": outer } }
+        ]),
+    );
+    let s = load(&bytes);
+    let Light::Spot {
+        falloff: SpotFalloff::Cycles { cos_half, smooth },
+        ..
+    } = s.lights[0]
+    else {
+        panic!("{:?}", s.lights[0]);
+    };
+    assert!((cos_half - outer.cos()).abs() < 1e-6);
+    assert!(
+        (smooth - (1.0 - outer.cos()) * 0.3).abs() < 1e-6,
+        "{smooth}"
+    );
+    // blend 0: a hard edge.
+    let Light::Spot {
+        falloff: SpotFalloff::Cycles { smooth, .. },
+        ..
+    } = s.lights[1]
+    else {
+        panic!("{:?}", s.lights[1]);
+    };
+    assert_eq!(smooth, 0.0);
+}
+
+#[test]
+fn tesela_light_overrides_the_khr_copy() {
+    let mut both = khr(0);
+    both["TESELA_light"] = json!({ "type": "POINT", "color": [1, 1, 1], "power": 100.0 });
+    let bytes = lights_doc(
+        None,
+        json!([
+            { "extensions": both, "translation": [0, 1, 0] },
+            { "extensions": { "TESELA_light": { "type": "SPOT", "power": 40.0, "color": [1, 0, 0], "spot_size": 1.0, "spot_blend": 0.2 } } },
+            { "extensions": { "TESELA_light": { "type": "SUN", "strength": 3.0, "color": [1, 1, 0.5], "angle": 0.01 } } }
+        ]),
+        json!([{ "type": "point", "intensity": 5435.14 }]),
+    );
+    let s = load(&bytes);
+    assert_eq!(s.lights.len(), 3);
+    match &s.lights[0] {
+        Light::Point {
+            position,
+            intensity,
+        } => {
+            assert_eq!(*position, Vec3::Y);
+            assert!(intensity.abs_diff_eq(Vec3::splat(100.0 / (4.0 * PI)), 1e-5));
+        }
+        l => panic!("{l:?}"),
+    }
+    match &s.lights[1] {
+        Light::Spot {
+            intensity,
+            falloff,
+            direction,
+            ..
+        } => {
+            assert!(intensity.abs_diff_eq(Vec3::new(40.0 / (4.0 * PI), 0., 0.), 1e-5));
+            assert!(direction.abs_diff_eq(-Vec3::Z, 1e-6));
+            let ch = 0.5f32.cos();
+            assert_eq!(
+                *falloff,
+                SpotFalloff::Cycles {
+                    cos_half: ch,
+                    smooth: (1.0 - ch) * 0.2
+                }
+            );
+        }
+        l => panic!("{l:?}"),
+    }
+    match &s.lights[2] {
+        Light::Directional {
+            irradiance, angle, ..
+        } => {
+            assert!(irradiance.abs_diff_eq(Vec3::new(3., 3., 1.5), 1e-6));
+            assert_eq!(*angle, 0.01);
+        }
+        l => panic!("{l:?}"),
+    }
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+}
+
+#[test]
+fn tesela_area_lights_become_one_sided_emitters() {
+    // A 2 m square under a node scaled by 2 and turned to face down (-Z -> -Y).
+    let rot = Quat::from_rotation_x(-FRAC_PI_2);
+    let bytes = lights_doc(
+        None,
+        json!([
+            { "name": "Key", "rotation": rot.to_array(), "scale": [2, 2, 2], "translation": [0, 3, 0],
+              "extensions": { "TESELA_light": { "type": "AREA", "shape": "SQUARE", "size": 2.0, "power": 100.0, "color": [1, 0.5, 1] } } },
+            { "extensions": { "TESELA_light": { "type": "AREA", "shape": "DISK", "size": 1.0, "power": 10.0 } } },
+            { "extensions": { "TESELA_light": { "type": "AREA", "shape": "RECTANGLE", "size": 2.0, "size_y": 0.5, "power": 10.0 } } },
+            { "scale": [1, 1, -1],
+              "extensions": { "TESELA_light": { "type": "AREA", "shape": "ELLIPSE", "size": 2.0, "size_y": 1.0, "power": 10.0 } } }
+        ]),
+        json!([]),
+    );
+    let s = load(&bytes);
+    assert!(s.lights.is_empty());
+    assert_eq!(s.meshes.len(), 4);
+    let sq = &s.meshes[0];
+    assert_eq!(sq.name, "Key");
+    assert_eq!(sq.indices.len(), 2);
+    assert!(sq.positions.iter().all(|p| (p.y - 3.0).abs() < 1e-5));
+    assert!(
+        face_normal(&s, 0).abs_diff_eq(-Vec3::Y, 1e-5),
+        "faces the node's -Z"
+    );
+    let m = &s.materials[sq.material];
+    assert!(!m.emission_two_sided && !m.double_sided);
+    let area = 16.0; // (2 m × scale 2)²
+    assert!(
+        m.emission
+            .abs_diff_eq(Vec3::new(1., 0.5, 1.) * 100.0 / (PI * area), 1e-5)
+    );
+
+    let disk = &s.meshes[1];
+    assert_eq!(disk.indices.len(), 64);
+    let poly = 0.5 * 64.0 * (2.0 * PI / 64.0).sin() * 0.25;
+    let e = s.materials[disk.material].emission;
+    assert!((e.x - 10.0 / (PI * poly)).abs() < 1e-4, "{e}");
+    assert!(face_normal(&s, 1).abs_diff_eq(-Vec3::Z, 1e-5));
+
+    let rect = &s.materials[s.meshes[2].material];
+    assert!((rect.emission.x - 10.0 / PI).abs() < 1e-4, "area 1 m²");
+    // Mirrored in Z: the light now faces +Z, and the winding follows.
+    assert!(face_normal(&s, 3).abs_diff_eq(Vec3::Z, 1e-5));
+}
+
+#[test]
+fn tesela_world_render_and_emission() {
+    let mut b = Bin::default();
+    let p = b.vec3(&[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]]);
+    let bytes = b.finish(json!({
+        "extensionsUsed": ["TESELA_world", "TESELA_render", "TESELA_emission", "KHR_materials_emissive_strength"],
+        "extensions": {
+            "TESELA_world": { "color": [0.1, 0.2, 0.3], "strength": 2.0 },
+            "TESELA_render": { "width": 640, "height": 480, "spp": 64, "max_depth": 14, "seed": 7, "integrator": "path_mis" }
+        },
+        "nodes": [{ "mesh": 0 }],
+        "materials": [
+            { "emissiveFactor": [1, 0.5, 0.25], "doubleSided": true,
+              "extensions": { "TESELA_emission": { "two_sided": false },
+                              "KHR_materials_emissive_strength": { "emissiveStrength": 4 } } },
+            { "emissiveFactor": [1, 1, 1],
+              "extensions": { "TESELA_emission": { "two_sided": true } } },
+            { "emissiveFactor": [1, 1, 1], "doubleSided": true }
+        ],
+        "meshes": [{ "primitives": [
+            { "attributes": { "POSITION": p }, "material": 0 },
+            { "attributes": { "POSITION": p }, "material": 1 },
+            { "attributes": { "POSITION": p }, "material": 2 },
+            { "attributes": { "POSITION": p }, "material": 0 }
+        ] }]
+    }));
+    let s = load(&bytes);
+    assert!(s.background.abs_diff_eq(Vec3::new(0.2, 0.4, 0.6), 1e-6));
+    let r = &s.settings;
+    assert_eq!(
+        (r.width, r.height, r.spp, r.max_depth, r.seed),
+        (Some(640), Some(480), Some(64), Some(14), Some(7))
+    );
+    assert_eq!(r.integrator.as_deref(), Some("path_mis"));
+    assert_eq!(s.materials.len(), 3, "material 0 is shared, not duplicated");
+    let m0 = &s.materials[s.meshes[0].material];
+    assert!(m0.emission.abs_diff_eq(Vec3::new(4., 2., 1.), 1e-6));
+    assert!(m0.double_sided && !m0.emission_two_sided);
+    let m1 = &s.materials[s.meshes[1].material];
+    assert!(!m1.double_sided && m1.emission_two_sided);
+    let m2 = &s.materials[s.meshes[2].material];
+    assert!(m2.double_sided && m2.emission_two_sided);
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+}
+
+#[test]
+fn texture_transform_is_accepted_with_one_warning() {
+    let mut b = Bin::default();
+    let p = b.vec3(&[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]]);
+    // A 1x1 PNG is not needed: the image is in a data URI built from a real encoder.
+    let mut png = Vec::new();
+    image::RgbaImage::from_pixel(2, 1, image::Rgba([10, 20, 30, 255]))
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    let uri = format!(
+        "data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&png)
+    );
+    let tt = json!({ "index": 0, "extensions": { "KHR_texture_transform": { "scale": [2, 2] } } });
+    let bytes = b.finish(json!({
+        "extensionsUsed": ["KHR_texture_transform"],
+        "extensionsRequired": ["KHR_texture_transform"],
+        "nodes": [{ "mesh": 0 }],
+        "images": [{ "uri": uri }],
+        "samplers": [{ "magFilter": 9728, "wrapS": 33071, "wrapT": 33648 }],
+        "textures": [{ "source": 0, "sampler": 0 }],
+        "materials": [{ "pbrMetallicRoughness": { "baseColorTexture": tt.clone() }, "emissiveTexture": tt }],
+        "meshes": [{ "primitives": [{ "attributes": { "POSITION": p }, "material": 0 }] }]
+    }));
+    let s = load(&bytes);
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    assert!(s.warnings[0].contains("KHR_texture_transform"));
+    assert_eq!(s.images.len(), 1);
+    assert_eq!(s.textures.len(), 1, "one texture shared by two slots");
+    let t = &s.textures[0];
+    assert!(t.nearest);
+    assert_eq!(
+        (t.wrap_s, t.wrap_t),
+        (
+            crate::scene::Wrap::ClampToEdge,
+            crate::scene::Wrap::MirroredRepeat
+        )
+    );
+    assert_eq!(s.images[0].rgba8, vec![[10, 20, 30, 255]; 2]);
+}
