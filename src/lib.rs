@@ -1,3 +1,20 @@
 //! Tesela: a physically based renderer for glTF scenes and Blender.
+//!
+//! Pipeline: [`scene`] (glTF or built-in) → [`render_scene::RenderScene`] (BVH, emitters) →
+//! [`render::render`] (tiles, [`integrator`]s, [`bsdf`]s, [`emitter`]s) → [`output`] or the
+//! [`protocol`] pipe.
 
+pub mod accel;
+pub mod bsdf;
+pub mod camera;
+pub mod emitter;
+pub mod frame;
+pub mod integrator;
+pub mod output;
+pub mod protocol;
+pub mod render;
+pub mod render_scene;
+pub mod sampler;
+pub mod sampling;
 pub mod scene;
+pub mod texture;

@@ -1,3 +1,430 @@
-fn main() {
-    println!("tesela: under construction");
+//! The `tesela` command line: render a glTF scene (or a built-in one) to EXR/PNG, or stream
+//! tiles to the Blender add-on over a pipe (`--pipe`, see docs/protocol.md).
+
+use clap::{Parser, Subcommand};
+use std::io::{BufWriter, Read, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+use tesela::emitter::LightChoice;
+use tesela::protocol::{self, Message};
+use tesela::render::{self, RenderError, RenderOptions};
+use tesela::render_scene::RenderScene;
+use tesela::scene::{self, Scene};
+
+/// Exit status: the render failed.
+const EXIT_RENDER: u8 = 1;
+/// Exit status: the scene could not be loaded.
+const EXIT_LOAD: u8 = 3;
+/// Exit status: cancelled (stdin closed in pipe mode, or SIGTERM/SIGINT).
+const EXIT_CANCELLED: u8 = 130;
+
+/// Set by SIGTERM/SIGINT or by stdin reaching EOF in pipe mode; polled by the render loop.
+static CANCEL: AtomicBool = AtomicBool::new(false);
+
+#[derive(Parser)]
+#[command(
+    name = "tesela",
+    version,
+    about = "Tesela: a physically based renderer for glTF 2.0 scenes and Blender",
+    after_help = "Exit status: 0 success, 1 render failed, 2 bad usage, 3 scene could not be loaded, 130 cancelled."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to an image (or to the Blender add-on with --pipe).
+    Render(RenderArgs),
+    /// Print what a scene contains (meshes, triangles, materials, lights, camera, warnings).
+    Info {
+        /// A .gltf or .glb file.
+        scene: PathBuf,
+    },
+    /// Write a built-in scene as a .gltf file (how scenes/*.gltf are made).
+    ExportBuiltin {
+        /// One of: cornell-box, cornell-spheres, glass-pane.
+        name: String,
+        /// Output .gltf path (buffers are embedded as data URIs).
+        out: PathBuf,
+    },
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// The scene: a .gltf or .glb file. Without it, the built-in Cornell box is rendered.
+    scene: Option<PathBuf>,
+    /// Render a built-in scene instead of a file: cornell-box, cornell-spheres, glass-pane.
+    #[arg(long, conflicts_with = "scene")]
+    builtin: Option<String>,
+    /// Output image; the extension picks the format: .exr (linear float RGBA) or .png (sRGB).
+    /// Default: tesela.png (no file in --pipe mode unless given).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Integrator: direct_ems, direct_mats, direct_mis, path_mats, path_mis, normals, albedo.
+    /// Default: the scene's TESELA_render setting, else path_mis.
+    #[arg(long)]
+    integrator: Option<String>,
+    /// Samples per pixel. Default: the scene's setting, else 64.
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Maximum path depth in vertices (Mitsuba's convention): 1 = emitters seen directly,
+    /// 2 = direct illumination; Cycles' max_bounces b is depth b + 2. Default 16.
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Image width in pixels. Default: the scene's setting, else 512.
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels. Default: the scene's setting, else from the camera's aspect ratio.
+    #[arg(long)]
+    height: Option<u32>,
+    /// Seed of the per-pixel random streams (same seed, same image, any thread count).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Worker threads (0 = one per core).
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// How a light is chosen for each shadow ray: power (proportional to emitted power) or
+    /// uniform (the seed's choice).
+    #[arg(long, default_value = "power", value_parser = ["power", "uniform"])]
+    light_choice: String,
+    /// Render only the window X Y W H of the full frame (pixels, top-left origin).
+    #[arg(long, num_args = 4, value_names = ["X", "Y", "W", "H"])]
+    region: Option<Vec<u32>>,
+    /// Tile edge in pixels.
+    #[arg(long, default_value_t = 32)]
+    tile_size: u32,
+    /// Stream binary frames on stdout for the Blender add-on (docs/protocol.md); stops when
+    /// stdin closes.
+    #[arg(long)]
+    pipe: bool,
+    /// No progress bar or summary.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+extern "C" fn on_signal(_: libc::c_int) {
+    CANCEL.store(true, Ordering::SeqCst);
+}
+
+fn install_signal_handlers() {
+    let handler = on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t;
+    // SAFETY: the handler only stores to an atomic, which is async-signal-safe.
+    unsafe {
+        libc::signal(libc::SIGTERM, handler);
+        libc::signal(libc::SIGINT, handler);
+    }
+}
+
+/// After a cancel, give the workers a moment to stop cleanly, then exit regardless.
+fn spawn_cancel_watchdog() {
+    std::thread::spawn(|| {
+        while !CANCEL.load(Ordering::SeqCst) {
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        std::thread::sleep(Duration::from_millis(250));
+        eprintln!("tesela: CANCELLED");
+        std::process::exit(EXIT_CANCELLED as i32);
+    });
+}
+
+fn load_scene(args: &RenderArgs) -> Result<Scene, String> {
+    if let Some(name) = &args.builtin {
+        return scene::builtin::by_name(name).ok_or_else(|| {
+            format!(
+                "unknown built-in scene `{name}` (choose one of {})",
+                scene::builtin::NAMES.join(", ")
+            )
+        });
+    }
+    match &args.scene {
+        Some(path) => scene::gltf::load(path).map_err(|e| e.to_string()),
+        None => Ok(scene::builtin::cornell_box()),
+    }
+}
+
+fn options(args: &RenderArgs, scene: &Scene) -> RenderOptions {
+    let s = &scene.settings;
+    let aspect = scene.camera.and_then(|c| c.aspect).filter(|a| a.is_finite() && *a > 0.0);
+    let width = args.width.or(s.width).unwrap_or(512);
+    let height = args.height.or(s.height).unwrap_or_else(|| match (args.width.or(s.width), aspect) {
+        (_, Some(a)) => ((width as f32 / a).round() as u32).max(1),
+        _ => width,
+    });
+    RenderOptions {
+        width,
+        height,
+        spp: args.spp.or(s.spp).unwrap_or(64),
+        max_depth: args.max_depth.or(s.max_depth).unwrap_or(16),
+        seed: args.seed.or(s.seed).unwrap_or(0),
+        integrator: args
+            .integrator
+            .clone()
+            .or_else(|| s.integrator.clone())
+            .unwrap_or_else(|| "path_mis".into()),
+        threads: args.threads,
+        tile_size: args.tile_size,
+        region: args.region.as_ref().map(|r| [r[0], r[1], r[2], r[3]]),
+    }
+}
+
+/// Pipe mode: frames on stdout, stop when stdin closes.
+fn run_pipe(args: &RenderArgs) -> ExitCode {
+    std::thread::spawn(|| {
+        let mut buf = [0u8; 256];
+        let mut stdin = std::io::stdin();
+        loop {
+            match stdin.read(&mut buf) {
+                Ok(0) | Err(_) => break,
+                Ok(_) => {}
+            }
+        }
+        CANCEL.store(true, Ordering::SeqCst);
+    });
+    let out = Mutex::new(BufWriter::with_capacity(1 << 20, std::io::stdout()));
+    let send = |m: &Message| {
+        let mut o = out.lock().unwrap_or_else(|e| e.into_inner());
+        // A closed stdout means the reader is gone: stop.
+        if protocol::write(&mut *o, m).and_then(|_| o.flush()).is_err() {
+            CANCEL.store(true, Ordering::SeqCst);
+        }
+    };
+    let scene = match load_scene(args) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("tesela: {e}");
+            send(&Message::Error(e));
+            return ExitCode::from(EXIT_LOAD);
+        }
+    };
+    let opts = options(args, &scene);
+    if let Err(e) = render::validate(&opts) {
+        send(&Message::Error(e.to_string()));
+        return ExitCode::from(EXIT_RENDER);
+    }
+    let rscene = RenderScene::new(scene, light_choice(args));
+    let [_, _, rw, rh] = opts.region.unwrap_or([0, 0, opts.width, opts.height]);
+    let ts = opts.tile_size.max(1);
+    send(&Message::Hello {
+        version: protocol::VERSION,
+        width: rw,
+        height: rh,
+        spp: opts.spp,
+        tile_count: rw.div_ceil(ts) * rh.div_ceil(ts),
+    });
+    for w in &rscene.scene.warnings {
+        send(&Message::Log {
+            level: 2,
+            message: w.clone(),
+        });
+    }
+    let start = std::time::Instant::now();
+    let on_tile = |t: &render::Tile, done: usize, total: usize| {
+        let rgba = t.pixels.iter().flatten().copied().collect();
+        send(&Message::Tile {
+            x: t.x,
+            y: t.y,
+            w: t.w,
+            h: t.h,
+            rgba,
+        });
+        send(&Message::Progress {
+            tiles_done: done as u32,
+            tiles_total: total as u32,
+            spp: opts.spp,
+            elapsed: start.elapsed().as_secs_f64(),
+        });
+    };
+    match render::render(&rscene, &opts, &CANCEL, &on_tile) {
+        Ok((image, stats)) => {
+            if let Some(path) = &args.output
+                && let Err(e) = tesela::output::write(&image, path)
+            {
+                send(&Message::Error(e));
+                return ExitCode::from(EXIT_RENDER);
+            }
+            send(&Message::Done(serde_json::to_string(&stats).unwrap_or_default()));
+            ExitCode::SUCCESS
+        }
+        Err(RenderError::Cancelled) => {
+            eprintln!("tesela: CANCELLED");
+            ExitCode::from(EXIT_CANCELLED)
+        }
+        Err(e) => {
+            send(&Message::Error(e.to_string()));
+            ExitCode::from(EXIT_RENDER)
+        }
+    }
+}
+
+fn light_choice(args: &RenderArgs) -> LightChoice {
+    if args.light_choice == "uniform" {
+        LightChoice::Uniform
+    } else {
+        LightChoice::Power
+    }
+}
+
+fn run_render(args: &RenderArgs) -> ExitCode {
+    let scene = match load_scene(args) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("tesela: error: {e}");
+            return ExitCode::from(EXIT_LOAD);
+        }
+    };
+    let opts = options(args, &scene);
+    if let Err(e) = render::validate(&opts) {
+        eprintln!("tesela: error: {e}");
+        return ExitCode::from(EXIT_RENDER);
+    }
+    let output = args.output.clone().unwrap_or_else(|| PathBuf::from("tesela.png"));
+    if let Err(e) = check_output(&output) {
+        eprintln!("tesela: error: {e}");
+        return ExitCode::from(EXIT_RENDER);
+    }
+    let build = std::time::Instant::now();
+    let rscene = RenderScene::new(scene, light_choice(args));
+    for w in &rscene.scene.warnings {
+        eprintln!("tesela: warning: {w}");
+    }
+    if rscene.triangle_count() == 0 && rscene.lights.is_empty() {
+        eprintln!("tesela: warning: the scene has no triangles and no lights");
+    }
+    let build_s = build.elapsed().as_secs_f64();
+    let bar = if args.quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        let b = indicatif::ProgressBar::new(1);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} tiles ({eta})",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b
+    };
+    let on_tile = |_: &render::Tile, done: usize, total: usize| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    };
+    let result = render::render(&rscene, &opts, &CANCEL, &on_tile);
+    bar.finish_and_clear();
+    match result {
+        Ok((image, stats)) => {
+            if let Err(e) = tesela::output::write(&image, &output) {
+                eprintln!("tesela: error: {e}");
+                return ExitCode::from(EXIT_RENDER);
+            }
+            if !args.quiet {
+                eprintln!(
+                    "tesela: {}x{} {} spp {} -> {} in {:.2} s (+{:.2} s BVH): {:.2} M samples/s, {:.2} M rays/s, {} triangles{}",
+                    image.width,
+                    image.height,
+                    opts.spp,
+                    opts.integrator,
+                    output.display(),
+                    stats.seconds,
+                    build_s,
+                    stats.samples_per_second / 1e6,
+                    stats.rays_per_second / 1e6,
+                    rscene.triangle_count(),
+                    if stats.rejected_samples > 0 {
+                        format!(", {} non-finite samples rejected", stats.rejected_samples)
+                    } else {
+                        String::new()
+                    }
+                );
+            }
+            ExitCode::SUCCESS
+        }
+        Err(RenderError::Cancelled) => {
+            eprintln!("tesela: cancelled");
+            ExitCode::from(EXIT_CANCELLED)
+        }
+        Err(e) => {
+            eprintln!("tesela: error: {e}");
+            ExitCode::from(EXIT_RENDER)
+        }
+    }
+}
+
+/// Refuses an output path whose format is unknown before spending time on the render.
+fn check_output(path: &Path) -> Result<(), String> {
+    match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()) {
+        Some(e) if e == "png" || e == "exr" => Ok(()),
+        _ => Err(format!(
+            "{}: unknown output format (use a .exr or .png file name)",
+            path.display()
+        )),
+    }
+}
+
+fn run_info(path: &Path) -> ExitCode {
+    match scene::gltf::load(path) {
+        Ok(s) => {
+            println!("{}", path.display());
+            println!("  meshes: {}, triangles: {}", s.meshes.len(), s.triangle_count());
+            println!("  materials: {}", s.materials.len());
+            for m in &s.materials {
+                println!(
+                    "    {}: base {:?} metallic {} roughness {} emission {:?} transmission {} ior {} specular {}",
+                    m.name, m.base_color, m.metallic, m.roughness, m.emission, m.transmission, m.ior, m.specular
+                );
+            }
+            println!("  lights: {}", s.lights.len());
+            for l in &s.lights {
+                println!("    {l:?}");
+            }
+            match &s.camera {
+                Some(c) => println!("  camera: {:?}", c.projection),
+                None => println!("  camera: none (a default camera frames the scene)"),
+            }
+            if let Some((lo, hi)) = s.bounds() {
+                println!("  bounds: {lo:?} .. {hi:?}");
+            }
+            println!("  background: {:?}", s.background);
+            for w in &s.warnings {
+                println!("  warning: {w}");
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("tesela: error: {e}");
+            ExitCode::from(EXIT_LOAD)
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    install_signal_handlers();
+    spawn_cancel_watchdog();
+    match cli.command {
+        Command::Render(args) => {
+            if args.pipe {
+                run_pipe(&args)
+            } else {
+                run_render(&args)
+            }
+        }
+        Command::Info { scene } => run_info(&scene),
+        Command::ExportBuiltin { name, out } => match scene::builtin::by_name(&name) {
+            Some(s) => match scene::gltf_write::write(&s, &out) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("tesela: error: {e}");
+                    ExitCode::from(EXIT_RENDER)
+                }
+            },
+            None => {
+                eprintln!("tesela: error: unknown built-in scene `{name}`");
+                ExitCode::from(2)
+            }
+        },
+    }
 }

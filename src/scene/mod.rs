@@ -4,8 +4,10 @@
 //! Colours are **linear** RGB; radiometric quantities are in watts (W/sr for intensity,
 //! W/m² for irradiance, W/(m² sr) for radiance).
 
+pub mod builtin;
 pub mod error;
 pub mod gltf;
+pub mod gltf_write;
 
 pub use error::{LoadError, LoadErrorKind};
 

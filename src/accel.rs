@@ -1,0 +1,209 @@
+//! Ray–triangle acceleration: an `obvhs` compressed wide BVH (CWBVH8) over every triangle.
+//!
+//! Triangles are stored in BVH leaf order so a leaf's triangles are contiguous in memory.
+//! Intersection is Möller–Trumbore in single precision; callers offset ray origins
+//! (see [`offset_origin`]) because the test is not watertight.
+
+use glam::{Vec3, Vec3A};
+use obvhs::{
+    BvhBuildParams, cwbvh::CwBvh, cwbvh::builder::build_cwbvh_from_tris, ray::Ray as BvhRay,
+    ray::RayHit, triangle::Triangle,
+};
+use std::time::Duration;
+
+/// A triangle prepared for intersection: `v0` and the edges `e1 = v1 - v0`, `e2 = v2 - v0`.
+#[derive(Clone, Copy, Debug)]
+struct PackedTriangle {
+    v0: Vec3A,
+    e1: Vec3A,
+    e2: Vec3A,
+}
+
+/// The closest intersection along a ray.
+#[derive(Clone, Copy, Debug)]
+pub struct Hit {
+    /// Ray parameter of the hit (distance for a unit direction).
+    pub t: f32,
+    /// Index of the triangle in the order it was given to [`Accel::build`].
+    pub triangle: u32,
+    /// Barycentric weight of vertex 1.
+    pub u: f32,
+    /// Barycentric weight of vertex 2 (vertex 0 has `1 - u - v`).
+    pub v: f32,
+}
+
+/// A BVH over triangles.
+pub struct Accel {
+    bvh: CwBvh,
+    tris: Vec<PackedTriangle>,
+    /// For each stored triangle, its index in the input order.
+    ids: Vec<u32>,
+}
+
+/// Möller–Trumbore: `(t, u, v)` of the hit inside `(tmin, tmax)`, else `None`.
+#[inline(always)]
+fn intersect_triangle(
+    tri: &PackedTriangle,
+    o: Vec3A,
+    d: Vec3A,
+    tmin: f32,
+    tmax: f32,
+) -> Option<(f32, f32, f32)> {
+    let pvec = d.cross(tri.e2);
+    let det = tri.e1.dot(pvec);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let tvec = o - tri.v0;
+    let u = tvec.dot(pvec) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let qvec = tvec.cross(tri.e1);
+    let v = d.dot(qvec) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    let t = tri.e2.dot(qvec) * inv;
+    (t > tmin && t < tmax).then_some((t, u, v))
+}
+
+impl Accel {
+    /// Builds the BVH over `triangles` (world-space vertex triples).
+    pub fn build(triangles: &[[Vec3; 3]]) -> Accel {
+        if triangles.is_empty() {
+            return Accel {
+                bvh: CwBvh::default(),
+                tris: Vec::new(),
+                ids: Vec::new(),
+            };
+        }
+        let input: Vec<Triangle> = triangles
+            .iter()
+            .map(|t| Triangle {
+                v0: t[0].into(),
+                v1: t[1].into(),
+                v2: t[2].into(),
+            })
+            .collect();
+        let mut build_time = Duration::ZERO;
+        let bvh = build_cwbvh_from_tris(&input, BvhBuildParams::medium_build(), &mut build_time);
+        let ids = bvh.primitive_indices.clone();
+        let tris = ids
+            .iter()
+            .map(|&i| {
+                let t = &input[i as usize];
+                PackedTriangle {
+                    v0: t.v0,
+                    e1: t.v1 - t.v0,
+                    e2: t.v2 - t.v0,
+                }
+            })
+            .collect();
+        Accel { bvh, tris, ids }
+    }
+
+    /// Closest hit of the ray `o + t d` with `t` in `(tmin, tmax)`.
+    #[inline]
+    pub fn intersect(&self, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
+        if self.tris.is_empty() {
+            return None;
+        }
+        let ray = BvhRay::new(o.into(), d.into(), tmin, tmax);
+        let mut hit = RayHit::none();
+        let (mut bu, mut bv) = (0.0, 0.0);
+        let tris = &self.tris;
+        let found = self.bvh.ray_traverse(ray, &mut hit, |r, id| {
+            match intersect_triangle(&tris[id], r.origin, r.direction, r.tmin, r.tmax) {
+                Some((t, u, v)) => {
+                    bu = u;
+                    bv = v;
+                    t
+                }
+                None => f32::INFINITY,
+            }
+        });
+        found.then(|| Hit {
+            t: hit.t,
+            triangle: self.ids[hit.primitive_id as usize],
+            u: bu,
+            v: bv,
+        })
+    }
+
+    /// True when any triangle lies on the ray with `t` in `(tmin, tmax)`.
+    #[inline]
+    pub fn occluded(&self, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> bool {
+        if self.tris.is_empty() {
+            return false;
+        }
+        let ray = BvhRay::new(o.into(), d.into(), tmin, tmax);
+        let tris = &self.tris;
+        !self.bvh.ray_traverse_miss(ray, |r, id| {
+            match intersect_triangle(&tris[id], r.origin, r.direction, r.tmin, r.tmax) {
+                Some((t, _, _)) => t,
+                None => f32::INFINITY,
+            }
+        })
+    }
+}
+
+/// Moves a surface point off its surface along the geometric normal `ng` to the side of `w`,
+/// by a distance proportional to the point's magnitude (the rounding error of its coordinates),
+/// so a ray leaving from it does not hit the same surface again.
+#[inline]
+pub fn offset_origin(p: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
+    let scale = 1e-4 * (1.0 + p.abs().max_element());
+    let n = if ng.dot(w) >= 0.0 { ng } else { -ng };
+    p + n * scale
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad(z: f32) -> Vec<[Vec3; 3]> {
+        let a = Vec3::new(-1.0, -1.0, z);
+        let b = Vec3::new(1.0, -1.0, z);
+        let c = Vec3::new(1.0, 1.0, z);
+        let d = Vec3::new(-1.0, 1.0, z);
+        vec![[a, b, c], [a, c, d]]
+    }
+
+    #[test]
+    fn closest_hit_and_occlusion() {
+        let mut tris = quad(0.0);
+        tris.extend(quad(-2.0));
+        let accel = Accel::build(&tris);
+        let h = accel
+            .intersect(Vec3::new(0.2, 0.3, 5.0), -Vec3::Z, 0.0, f32::INFINITY)
+            .unwrap();
+        assert!((h.t - 5.0).abs() < 1e-5);
+        assert!(h.triangle < 2, "nearest quad is the first one");
+        assert!(accel.occluded(Vec3::new(0.2, 0.3, 5.0), -Vec3::Z, 0.0, 6.0));
+        assert!(!accel.occluded(Vec3::new(0.2, 0.3, 5.0), -Vec3::Z, 0.0, 4.9));
+        assert!(accel.intersect(Vec3::new(3.0, 0.0, 5.0), -Vec3::Z, 0.0, f32::INFINITY).is_none());
+    }
+
+    #[test]
+    fn shared_edge_has_no_gap() {
+        // Rays through the diagonal shared by the two triangles must hit one of them.
+        let accel = Accel::build(&quad(0.0));
+        for i in 0..1000 {
+            let s = -0.99 + 1.98 * i as f32 / 999.0;
+            let o = Vec3::new(s, s, 1.0);
+            assert!(accel.intersect(o, -Vec3::Z, 0.0, 10.0).is_some(), "gap at {s}");
+        }
+    }
+
+    #[test]
+    fn barycentrics_locate_the_hit() {
+        let tri = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let accel = Accel::build(&[tri]);
+        let h = accel
+            .intersect(Vec3::new(0.25, 0.5, 1.0), -Vec3::Z, 0.0, 10.0)
+            .unwrap();
+        assert!((h.u - 0.25).abs() < 1e-6 && (h.v - 0.5).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,53 @@
+//! Lambertian reflection: `f = albedo / π`, sampled with a cosine-weighted hemisphere.
+
+use super::{Bsdf, BsdfQueryRecord, Measure};
+use crate::sampling::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
+use glam::{Vec2, Vec3};
+use std::f32::consts::FRAC_1_PI;
+
+/// A Lambertian reflector of the given albedo (reflects on the `+Z` side only).
+#[derive(Clone, Copy, Debug)]
+pub struct Diffuse {
+    pub albedo: Vec3,
+}
+
+impl Diffuse {
+    pub fn new(albedo: Vec3) -> Self {
+        Diffuse { albedo }
+    }
+}
+
+impl Bsdf for Diffuse {
+    fn sample(&self, rec: &mut BsdfQueryRecord, u: Vec2, _u1: f32) -> Vec3 {
+        if rec.wi.z <= 0.0 {
+            return Vec3::ZERO;
+        }
+        rec.wo = square_to_cosine_hemisphere(u);
+        rec.eta = 1.0;
+        rec.measure = Measure::SolidAngle;
+        rec.pdf = square_to_cosine_hemisphere_pdf(rec.wo);
+        if rec.pdf <= 0.0 {
+            return Vec3::ZERO;
+        }
+        // f cos / pdf = (albedo/π) cos / (cos/π)
+        self.albedo
+    }
+
+    fn eval(&self, rec: &BsdfQueryRecord) -> Vec3 {
+        if rec.wi.z <= 0.0 || rec.wo.z <= 0.0 {
+            return Vec3::ZERO;
+        }
+        self.albedo * FRAC_1_PI
+    }
+
+    fn pdf(&self, rec: &BsdfQueryRecord) -> f32 {
+        if rec.wi.z <= 0.0 {
+            return 0.0;
+        }
+        square_to_cosine_hemisphere_pdf(rec.wo)
+    }
+
+    fn is_delta(&self) -> bool {
+        false
+    }
+}

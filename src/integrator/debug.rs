@@ -1,0 +1,28 @@
+//! Debug views: shading normals mapped to colours (`n · 0.5 + 0.5`) and surface albedo
+//! (base colour after textures) at the first hit; black where the ray escapes.
+
+use super::Integrator;
+use crate::render_scene::{Ctx, RenderScene};
+use glam::Vec3;
+
+pub struct Normals;
+
+pub struct Albedo;
+
+impl Integrator for Normals {
+    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
+        match scene.intersect(ctx, o, d) {
+            Some(its) => its.ns * 0.5 + Vec3::splat(0.5),
+            None => Vec3::ZERO,
+        }
+    }
+}
+
+impl Integrator for Albedo {
+    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
+        match scene.intersect(ctx, o, d) {
+            Some(its) => scene.surface_params(&its).base_color,
+            None => Vec3::ZERO,
+        }
+    }
+}

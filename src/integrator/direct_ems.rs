@@ -1,0 +1,45 @@
+//! Direct illumination by emitter sampling (the seed's `direct_ems`): at the first non-delta
+//! surface, one light sample and a shadow ray. Emitters seen directly (or through a chain of
+//! delta bounces) show their radiance.
+
+use super::{Integrator, ShadingPoint, sample_emitter, spawn};
+use crate::render_scene::{Ctx, RenderScene};
+use glam::Vec3;
+
+pub struct DirectEms {
+    pub max_depth: u32,
+}
+
+impl Integrator for DirectEms {
+    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, mut o: Vec3, mut d: Vec3) -> Vec3 {
+        let mut l = Vec3::ZERO;
+        let mut throughput = Vec3::ONE;
+        let mut depth = 1;
+        loop {
+            let Some(its) = scene.intersect(ctx, o, d) else {
+                if let Some((_, le, _)) = scene.background_radiance(d, o) {
+                    l += throughput * le;
+                }
+                return l;
+            };
+            if let Some((_, le, _)) = scene.emitted(&its, d, o) {
+                l += throughput * le;
+            }
+            if depth >= self.max_depth {
+                return l;
+            }
+            let sp = ShadingPoint::new(scene, ctx, &its, d);
+            if !sp.bsdf_is_delta() {
+                return l + throughput * sample_emitter(scene, ctx, &its, &sp, d, false);
+            }
+            // Emitter sampling cannot see a delta BSDF: follow it.
+            let Some((wo, w, _)) = sp.sample(ctx, &its, d) else {
+                return l;
+            };
+            throughput *= w;
+            o = spawn(&its, wo);
+            d = wo;
+            depth += 1;
+        }
+    }
+}

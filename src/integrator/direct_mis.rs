@@ -1,0 +1,57 @@
+//! Direct illumination with multiple importance sampling (the seed's `direct_mis`): one emitter
+//! sample and one BSDF sample at the first non-delta surface, combined with the power
+//! heuristic. Delta BSDF samples and delta lights get weight 1 (the other strategy cannot
+//! produce them). The light-choice probability is part of the emitter density on both sides.
+
+use super::{Integrator, ShadingPoint, mis_weight, sample_emitter, spawn};
+use crate::bsdf::Measure;
+use crate::render_scene::{Ctx, RenderScene};
+use glam::Vec3;
+
+pub struct DirectMis {
+    pub max_depth: u32,
+}
+
+impl Integrator for DirectMis {
+    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, mut o: Vec3, mut d: Vec3) -> Vec3 {
+        let mut l = Vec3::ZERO;
+        let mut throughput = Vec3::ONE;
+        let mut depth = 1;
+        loop {
+            let Some(its) = scene.intersect(ctx, o, d) else {
+                if let Some((_, le, _)) = scene.background_radiance(d, o) {
+                    l += throughput * le;
+                }
+                return l;
+            };
+            if let Some((_, le, _)) = scene.emitted(&its, d, o) {
+                l += throughput * le;
+            }
+            if depth >= self.max_depth {
+                return l;
+            }
+            let sp = ShadingPoint::new(scene, ctx, &its, d);
+            if !sp.bsdf_is_delta() {
+                l += throughput * sample_emitter(scene, ctx, &its, &sp, d, true);
+            }
+            let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
+                return l;
+            };
+            throughput *= w;
+            o = spawn(&its, wo);
+            d = wo;
+            depth += 1;
+            if rec.measure != Measure::Discrete {
+                // The BSDF half of MIS at this vertex, then stop.
+                let hit = match scene.intersect(ctx, o, d) {
+                    Some(next) => scene.emitted(&next, d, o),
+                    None => scene.background_radiance(d, o),
+                };
+                if let Some((e, le, erec)) = hit {
+                    l += throughput * le * mis_weight(rec.pdf, scene.light_pdf(e, &erec));
+                }
+                return l;
+            }
+        }
+    }
+}

@@ -1,0 +1,167 @@
+//! Integrators: estimate the radiance arriving along a camera ray.
+//!
+//! Path depth counts **vertices** as Mitsuba does: the camera ray's first hit is vertex 1, so
+//! `max_depth = 1` shows only emitters seen directly, `2` is direct illumination, and Cycles'
+//! `max_bounces = b` corresponds to `b + 2`. Chains of delta (mirror/glass) bounces are followed
+//! by every integrator — emitter sampling cannot see through them, BSDF sampling can.
+
+pub mod debug;
+pub mod direct_ems;
+pub mod direct_mats;
+pub mod direct_mis;
+pub mod path;
+
+use crate::accel::offset_origin;
+use crate::bsdf::{self, Bsdf, BsdfInstance, BsdfQueryRecord};
+use crate::frame::Frame;
+use crate::render_scene::{Ctx, Intersection, RenderScene};
+use glam::Vec3;
+
+/// One integrator: radiance along the unit-direction ray `o + t d`.
+pub trait Integrator: Send + Sync {
+    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3;
+}
+
+/// The integrators selectable by name.
+pub const NAMES: [&str; 7] = [
+    "direct_ems",
+    "direct_mats",
+    "direct_mis",
+    "path_mats",
+    "path_mis",
+    "normals",
+    "albedo",
+];
+
+/// Builds the integrator called `name` with the given maximum path depth.
+pub fn by_name(name: &str, max_depth: u32) -> Option<Box<dyn Integrator>> {
+    Some(match name {
+        "direct_ems" => Box::new(direct_ems::DirectEms { max_depth }),
+        "direct_mats" => Box::new(direct_mats::DirectMats { max_depth }),
+        "direct_mis" => Box::new(direct_mis::DirectMis { max_depth }),
+        "path_mats" => Box::new(path::PathMats { max_depth }),
+        "path_mis" => Box::new(path::PathMis { max_depth }),
+        "normals" => Box::new(debug::Normals),
+        "albedo" => Box::new(debug::Albedo),
+        _ => return None,
+    })
+}
+
+/// The BSDF at a hit in its shading frame, with the local direction towards the ray's origin.
+pub struct ShadingPoint {
+    pub bsdf: BsdfInstance,
+    pub frame: Frame,
+    /// Local direction towards the previous vertex.
+    pub wi: Vec3,
+}
+
+impl ShadingPoint {
+    /// Chooses the BSDF (one random number) and sets up the frame. Opaque surfaces shade
+    /// both faces (the frame is flipped towards the viewer); transmissive ones keep the
+    /// normal's side to tell entering from leaving.
+    pub fn new(scene: &RenderScene, ctx: &mut Ctx, its: &Intersection, d: Vec3) -> Self {
+        let params = scene.surface_params(its);
+        let bsdf = bsdf::choose(&params, ctx.sampler.next_1d());
+        let mut n = its.ns;
+        if !bsdf.is_transmissive() && n.dot(-d) < 0.0 {
+            n = -n;
+        }
+        let frame = Frame::from_normal(n);
+        ShadingPoint {
+            bsdf,
+            wi: frame.to_local(-d),
+            frame,
+        }
+    }
+
+    /// True when the chosen BSDF is purely specular.
+    #[inline]
+    pub fn bsdf_is_delta(&self) -> bool {
+        self.bsdf.is_delta()
+    }
+
+    /// `f · |cos θo|` for a world direction `wo`, zero if `wo` would cross the geometric surface
+    /// on the wrong side for a reflection (avoids light leaks through shading normals).
+    #[inline]
+    pub fn eval_cos(&self, its: &Intersection, d: Vec3, wo: Vec3) -> Vec3 {
+        let lo = self.frame.to_local(wo);
+        if !self.bsdf.is_transmissive() && its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
+            return Vec3::ZERO;
+        }
+        self.bsdf.eval(&BsdfQueryRecord::pair(self.wi, lo)) * lo.z.abs()
+    }
+
+    /// BSDF density of world direction `wo` (per steradian).
+    #[inline]
+    pub fn pdf(&self, wo: Vec3) -> f32 {
+        self.bsdf
+            .pdf(&BsdfQueryRecord::pair(self.wi, self.frame.to_local(wo)))
+    }
+
+    /// Samples the BSDF: `(world direction, weight, record)`, or `None` if it failed.
+    #[inline]
+    pub fn sample(&self, ctx: &mut Ctx, its: &Intersection, d: Vec3) -> Option<(Vec3, Vec3, BsdfQueryRecord)> {
+        let mut rec = BsdfQueryRecord::new(self.wi);
+        let u = ctx.sampler.next_2d();
+        let u1 = ctx.sampler.next_1d();
+        let w = self.bsdf.sample(&mut rec, u, u1);
+        if w == Vec3::ZERO || !w.is_finite() {
+            return None;
+        }
+        let wo = self.frame.to_world(rec.wo);
+        // A reflection must leave on the viewer's side of the true surface.
+        let reflect = rec.wo.z * self.wi.z > 0.0;
+        if reflect && its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
+            return None;
+        }
+        Some((wo, w, rec))
+    }
+}
+
+/// Power heuristic (β = 2) weight of a strategy with density `a` against one with density `b`.
+#[inline]
+pub fn mis_weight(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 > 0.0 && (a2 + b2).is_finite() {
+        a2 / (a2 + b2)
+    } else if a.is_infinite() {
+        1.0
+    } else {
+        0.0
+    }
+}
+
+/// Emitter sampling at a shading point: `Σ f cos Le / pdf` for one light sample, weighted
+/// against BSDF sampling when `mis` (delta lights always get weight 1).
+#[inline]
+pub fn sample_emitter(
+    scene: &RenderScene,
+    ctx: &mut Ctx,
+    its: &Intersection,
+    sp: &ShadingPoint,
+    d: Vec3,
+    mis: bool,
+) -> Vec3 {
+    let uc = ctx.sampler.next_1d();
+    let u = ctx.sampler.next_2d();
+    let (light, rec, weight) = scene.sample_light(its.p, uc, u);
+    if weight == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let f = sp.eval_cos(its, d, rec.wi);
+    if f == Vec3::ZERO || !scene.unoccluded(ctx, its.p, its.ng, &rec) {
+        return Vec3::ZERO;
+    }
+    let w = if mis && !scene.is_delta_light(light) {
+        mis_weight(rec.pdf, sp.pdf(rec.wi))
+    } else {
+        1.0
+    };
+    f * weight * w
+}
+
+/// Origin for a ray leaving `its` along `wo`.
+#[inline]
+pub fn spawn(its: &Intersection, wo: Vec3) -> Vec3 {
+    offset_origin(its.p, its.ng, wo)
+}

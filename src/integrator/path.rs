@@ -1,0 +1,116 @@
+//! Unidirectional path tracing: `path_mats` (BSDF sampling only) and `path_mis` (emitter and
+//! BSDF sampling at every vertex, power heuristic). Russian roulette from vertex 4 on, on the
+//! throughput's **maximum** component (times the accumulated `η²` of refractions, so radiance
+//! scaling inside glass does not kill paths), survival probability capped at 0.95.
+
+use super::{Integrator, ShadingPoint, mis_weight, sample_emitter, spawn};
+use crate::bsdf::Measure;
+use crate::render_scene::{Ctx, RenderScene};
+use glam::Vec3;
+
+/// Depth (vertex count) from which Russian roulette applies.
+const RR_DEPTH: u32 = 4;
+
+pub struct PathMats {
+    pub max_depth: u32,
+}
+
+pub struct PathMis {
+    pub max_depth: u32,
+}
+
+/// Russian roulette: returns false to terminate, else rescales `throughput`.
+#[inline]
+fn roulette(ctx: &mut Ctx, depth: u32, throughput: &mut Vec3, eta_scale: f32) -> bool {
+    if depth < RR_DEPTH {
+        return true;
+    }
+    let q = (throughput.max_element() * eta_scale).min(0.95);
+    if q <= 0.0 || ctx.sampler.next_1d() >= q {
+        return false;
+    }
+    *throughput /= q;
+    true
+}
+
+impl Integrator for PathMats {
+    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, mut o: Vec3, mut d: Vec3) -> Vec3 {
+        let mut l = Vec3::ZERO;
+        let mut throughput = Vec3::ONE;
+        let mut eta_scale = 1.0;
+        let mut depth = 1;
+        loop {
+            let Some(its) = scene.intersect(ctx, o, d) else {
+                if let Some((_, le, _)) = scene.background_radiance(d, o) {
+                    l += throughput * le;
+                }
+                return l;
+            };
+            if let Some((_, le, _)) = scene.emitted(&its, d, o) {
+                l += throughput * le;
+            }
+            if depth >= self.max_depth || !roulette(ctx, depth, &mut throughput, eta_scale) {
+                return l;
+            }
+            let sp = ShadingPoint::new(scene, ctx, &its, d);
+            let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
+                return l;
+            };
+            throughput *= w;
+            eta_scale *= rec.eta * rec.eta;
+            o = spawn(&its, wo);
+            d = wo;
+            depth += 1;
+        }
+    }
+}
+
+impl Integrator for PathMis {
+    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, mut o: Vec3, mut d: Vec3) -> Vec3 {
+        let mut l = Vec3::ZERO;
+        let mut throughput = Vec3::ONE;
+        let mut eta_scale = 1.0;
+        let mut depth = 1;
+        // Density of the BSDF sample that produced the current ray; infinite for camera rays
+        // and delta samples (emitter sampling could not have produced them: MIS weight 1).
+        let mut bsdf_pdf = f32::INFINITY;
+        loop {
+            let hit = scene.intersect(ctx, o, d);
+            let emitted = match &hit {
+                Some(its) => scene.emitted(its, d, o),
+                None => scene.background_radiance(d, o),
+            };
+            if let Some((e, le, erec)) = emitted {
+                let w = if bsdf_pdf.is_infinite() {
+                    1.0
+                } else {
+                    mis_weight(bsdf_pdf, scene.light_pdf(e, &erec))
+                };
+                l += throughput * le * w;
+            }
+            let Some(its) = hit else {
+                return l;
+            };
+            if depth >= self.max_depth || !roulette(ctx, depth, &mut throughput, eta_scale) {
+                return l;
+            }
+            let sp = ShadingPoint::new(scene, ctx, &its, d);
+            if !sp.bsdf_is_delta() {
+                l += throughput * sample_emitter(scene, ctx, &its, &sp, d, true);
+            }
+            let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
+                return l;
+            };
+            bsdf_pdf = if rec.measure == Measure::Discrete {
+                f32::INFINITY
+            } else {
+                rec.pdf
+            };
+            throughput *= w;
+            eta_scale *= rec.eta * rec.eta;
+            o = spawn(&its, wo);
+            d = wo;
+            depth += 1;
+        }
+    }
+}
