@@ -505,3 +505,252 @@ fn mutated_inputs_never_panic() {
         }
     }
 }
+
+/// Every leaf (and object member) of a JSON document, as paths.
+#[derive(Clone)]
+enum Seg {
+    Key(String),
+    Idx(usize),
+}
+
+fn paths(v: &Value, here: &mut Vec<Seg>, out: &mut Vec<Vec<Seg>>) {
+    out.push(here.clone());
+    match v {
+        Value::Object(o) => {
+            for (k, c) in o {
+                here.push(Seg::Key(k.clone()));
+                paths(c, here, out);
+                here.pop();
+            }
+        }
+        Value::Array(a) => {
+            for (i, c) in a.iter().enumerate() {
+                here.push(Seg::Idx(i));
+                paths(c, here, out);
+                here.pop();
+            }
+        }
+        _ => {}
+    }
+}
+
+fn at<'a>(v: &'a mut Value, path: &[Seg]) -> Option<&'a mut Value> {
+    path.iter().try_fold(v, |v, s| match s {
+        Seg::Key(k) => v.get_mut(k.as_str()),
+        Seg::Idx(i) => v.get_mut(*i),
+    })
+}
+
+/// Structure-aware mutations: numbers, strings, removed members, duplicated elements.
+fn mutate(doc: &Value, rng: &mut Lcg) -> Value {
+    let mut d = doc.clone();
+    let mut all = Vec::new();
+    paths(&d, &mut Vec::new(), &mut all);
+    for _ in 0..1 + rng.next() % 3 {
+        let p = &all[(rng.next() as usize) % all.len()];
+        let Some(v) = at(&mut d, p) else { continue };
+        let numbers = [
+            json!(0),
+            json!(-1),
+            json!(1),
+            json!(2),
+            json!(3),
+            json!(7),
+            json!(255),
+            json!(65535),
+            json!(4294967295u64),
+            json!(4294967296u64),
+            json!(u64::MAX),
+            json!(1e300),
+            json!(-1e300),
+            json!(0.5),
+            json!(5125),
+            json!(5120),
+            json!(5126),
+        ];
+        let strings = [
+            "",
+            "../x.bin",
+            "/etc/passwd",
+            "http://x/y",
+            "data:,",
+            "data:application/octet-stream;base64,AAAA",
+            "data:image/png;base64,iVBORw0KGgo=",
+            "%",
+            "VEC3",
+            "MAT4",
+            "SCALAR",
+            "spot",
+            "AREA",
+            "DISK",
+            "SUN",
+            "orthographic",
+        ];
+        match rng.next() % 5 {
+            0 | 1 if v.is_number() || v.is_null() => {
+                *v = numbers[(rng.next() as usize) % numbers.len()].clone()
+            }
+            0 | 1 if v.is_string() => *v = json!(strings[(rng.next() as usize) % strings.len()]),
+            2 => {
+                if let Value::Array(a) = v
+                    && !a.is_empty()
+                {
+                    let i = (rng.next() as usize) % a.len();
+                    let e = a[i].clone();
+                    a.push(e);
+                }
+            }
+            3 => {
+                if let Value::Object(o) = v
+                    && !o.is_empty()
+                {
+                    let k = o
+                        .keys()
+                        .nth((rng.next() as usize) % o.len())
+                        .unwrap()
+                        .clone();
+                    o.remove(&k);
+                }
+            }
+            _ => {
+                if let Value::Array(a) = v {
+                    a.reverse();
+                }
+            }
+        }
+    }
+    d
+}
+
+/// A document that exercises most loader paths: sparse data, morph targets, strips,
+/// cameras, every light kind, textures from a bufferView, Tesela extensions.
+fn rich_doc() -> (Value, Vec<u8>) {
+    let mut bin = triangle_bin(&TRI, [0, 1, 2]);
+    let morph = f32s(&[0., 0., 1., 0., 0., 1., 0., 0., 1.]);
+    bin.extend_from_slice(&morph);
+    let mut png = Vec::new();
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([200, 100, 50, 255]))
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    let png_off = bin.len();
+    bin.extend_from_slice(&png);
+    let mut d = doc(None, bin.len());
+    d["buffers"][0].as_object_mut().unwrap().remove("uri");
+    d["bufferViews"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({ "buffer": 0, "byteOffset": 44, "byteLength": 36 }));
+    d["bufferViews"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({ "buffer": 0, "byteOffset": png_off, "byteLength": png.len() }));
+    d["accessors"].as_array_mut().unwrap().push(json!({
+        "bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC3",
+        "sparse": { "count": 1, "indices": { "bufferView": 0, "componentType": 5123 },
+                    "values": { "bufferView": 1 } } }));
+    d["meshes"] = json!([{
+        "weights": [0.5],
+        "primitives": [
+            { "attributes": { "POSITION": 1, "NORMAL": 2 }, "indices": 0, "material": 0,
+              "targets": [{ "POSITION": 2, "NORMAL": 2 }] },
+            { "attributes": { "POSITION": 1 }, "mode": 5 }
+        ]
+    }]);
+    d["images"] = json!([{ "bufferView": 3, "mimeType": "image/png" }]);
+    d["samplers"] = json!([{ "magFilter": 9728, "wrapS": 33648 }]);
+    d["textures"] = json!([{ "source": 0, "sampler": 0 }]);
+    d["materials"] = json!([{
+        "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 }, "metallicRoughnessTexture": { "index": 0 } },
+        "emissiveTexture": { "index": 0 }, "emissiveFactor": [1, 1, 1],
+        "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 3 },
+                        "KHR_materials_ior": { "ior": 1.4 }, "KHR_materials_transmission": { "transmissionFactor": 1 },
+                        "KHR_materials_specular": { "specularFactor": 0.5 }, "TESELA_emission": { "two_sided": true } } }]);
+    d["cameras"] = json!([
+        { "type": "perspective", "perspective": { "yfov": 0.8, "znear": 0.1, "aspectRatio": 1.5 } },
+        { "type": "orthographic", "orthographic": { "xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 5 } }
+    ]);
+    d["extensions"] = json!({
+        "KHR_lights_punctual": { "lights": [
+            { "type": "point", "intensity": 10 },
+            { "type": "spot", "spot": { "innerConeAngle": 0.1, "outerConeAngle": 0.4 } },
+            { "type": "directional", "color": [1, 0.5, 0.5] }
+        ] },
+        "TESELA_world": { "color": [0.1, 0.1, 0.1], "strength": 1 },
+        "TESELA_render": { "width": 64, "height": 48, "spp": 4 }
+    });
+    d["nodes"] = json!([
+        { "mesh": 0, "children": [1, 2, 3], "rotation": [0, 0.7071, 0, 0.7071] },
+        { "camera": 0, "translation": [0, 0, 3] },
+        { "extensions": { "KHR_lights_punctual": { "light": 1 } }, "scale": [1, -1, 1] },
+        { "children": [4, 5], "matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 1,2,3,1] },
+        { "extensions": { "TESELA_light": { "type": "AREA", "shape": "ELLIPSE", "size": 1, "size_y": 2, "power": 50 } } },
+        { "extensions": { "TESELA_light": { "type": "SPOT", "power": 50, "spot_size": 1, "spot_blend": 0.5 },
+                          "KHR_lights_punctual": { "light": 0 } } }
+    ]);
+    (d, bin)
+}
+
+fn fuzz_iterations(default: usize) -> usize {
+    std::env::var("TESELA_FUZZ_ITERS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+#[test]
+fn structured_mutations_never_panic() {
+    let (d, bin) = rich_doc();
+    let s = load_from_slice(&glb(&bytes(&d), &bin), None, "rich.glb").unwrap();
+    assert!(
+        s.camera.is_some() && s.lights.len() == 2 && s.meshes.len() == 3,
+        "{s:?}"
+    );
+    let mut rng = Lcg(99);
+    let (mut ok, mut failed) = (0, 0);
+    for _ in 0..fuzz_iterations(1500) {
+        let m = mutate(&d, &mut rng);
+        match load_from_slice(&glb(&bytes(&m), &bin), None, "m.glb") {
+            Ok(_) => ok += 1,
+            Err(e) => {
+                assert!(e.to_string().starts_with("m.glb: "), "{e}");
+                failed += 1;
+            }
+        }
+    }
+    // Both outcomes must occur, or the mutations are not reaching the loader.
+    assert!(ok > 0 && failed > 0, "{ok} loaded, {failed} failed");
+}
+
+#[test]
+fn structured_mutations_of_the_samples_never_panic() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/gltf-samples");
+    if !dir.is_dir() {
+        eprintln!("note: {} is absent; skipped", dir.display());
+        return;
+    }
+    let mut rng = Lcg(7);
+    for model in [
+        "Box",
+        "SimpleSparseAccessor",
+        "Cameras",
+        "MeshPrimitiveModes",
+        "AnimatedMorphCube",
+    ] {
+        for variant in ["glTF-Embedded", "glTF-Quantized", "glTF"] {
+            let folder = dir.join(model).join(variant);
+            let Some(file) = std::fs::read_dir(&folder).ok().and_then(|mut r| {
+                r.find_map(|e| {
+                    let p = e.ok()?.path();
+                    (p.extension()? == "gltf").then_some(p)
+                })
+            }) else {
+                continue;
+            };
+            let d: Value = serde_json::from_slice(&std::fs::read(&file).unwrap()).unwrap();
+            for _ in 0..fuzz_iterations(150) {
+                let m = mutate(&d, &mut rng);
+                let _ = load_from_slice(&bytes(&m), Some(&folder), "m.gltf");
+            }
+        }
+    }
+}
