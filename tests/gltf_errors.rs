@@ -679,7 +679,7 @@ fn rich_doc() -> (Value, Vec<u8>) {
         "TESELA_render": { "width": 64, "height": 48, "spp": 4 }
     });
     d["nodes"] = json!([
-        { "mesh": 0, "children": [1, 2, 3], "rotation": [0, 0.7071, 0, 0.7071] },
+        { "mesh": 0, "children": [1, 2, 3], "rotation": [0, 0.7, 0, 0.7] },
         { "camera": 0, "translation": [0, 0, 3] },
         { "extensions": { "KHR_lights_punctual": { "light": 1 } }, "scale": [1, -1, 1] },
         { "children": [4, 5], "matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 1,2,3,1] },
