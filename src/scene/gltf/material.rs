@@ -188,6 +188,13 @@ impl<'a> Loader<'a> {
             );
         }
         let ti = info.index.value();
+        let raw_texture = self.raw_item("textures", ti);
+        if raw_texture.is_object() && member(raw_texture, "source").is_none() {
+            self.warn_once(format!(
+                "texture {ti} has no `source` (only an extension's image format); material {gi} {slot} is left untextured"
+            ));
+            return Ok(None);
+        }
         let texture = self
             .texture(ti)
             .map_err(|e| LoadError::new(e.kind, format!("material {gi} {slot}: {}", e.message)))?;
@@ -207,6 +214,14 @@ impl<'a> Loader<'a> {
                 self.root.textures.len()
             ))
         })?;
+        if member(self.raw_item("textures", ti), "source").is_none() {
+            return Err(LoadError::new(
+                LoadErrorKind::Unsupported,
+                format!(
+                    "texture {ti} has no `source` (only an extension's image format, which is not supported)"
+                ),
+            ));
+        }
         let (wrap_s, wrap_t, nearest) = match t.sampler {
             Some(si) => {
                 let s = self.root.samplers.get(si.value()).ok_or_else(|| {

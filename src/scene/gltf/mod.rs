@@ -106,12 +106,7 @@ fn load_inner(bytes: &[u8], base_dir: Option<&Path>) -> Result<Scene, LoadError>
             "not a glTF file: the JSON is not an object",
         ));
     }
-    let root: json::Root = serde_json::from_slice(c.json).map_err(|e| {
-        LoadError::new(
-            LoadErrorKind::Format,
-            format!("not a valid glTF 2.0 document: {e}"),
-        )
-    })?;
+    let root = typed_document(&raw)?;
     let version = root.asset.version.trim();
     if !version.starts_with("2.") && version != "2" {
         return Err(LoadError::new(
@@ -164,6 +159,89 @@ fn load_inner(bytes: &[u8], base_dir: Option<&Path>) -> Result<Scene, LoadError>
     loader.root_extensions()?;
     loader.walk()?;
     Ok(loader.scene)
+}
+
+/// The typed document, deserialized by the `gltf` crate from a copy of the JSON that
+/// keeps only what the crate must check: extension and extras objects (read from the raw
+/// JSON instead), animations and skins (not used) are left out, and properties that glTF
+/// makes optional but the crate requires get neutral values (`scene.nodes`, a texture's
+/// `source`, which [`Loader::texture`] checks in the raw JSON).
+fn typed_document(raw: &Value) -> Result<json::Root, LoadError> {
+    fn strip(v: &mut Value) {
+        match v {
+            Value::Object(o) => {
+                o.remove("extensions");
+                o.remove("extras");
+                o.values_mut().for_each(strip);
+            }
+            Value::Array(a) => a.iter_mut().for_each(strip),
+            _ => {}
+        }
+    }
+    let mut v = raw.clone();
+    if let Some(o) = v.as_object_mut() {
+        o.remove("animations");
+        o.remove("skins");
+    }
+    strip(&mut v);
+    for key in ["scenes", "textures"] {
+        let Some(items) = v.get_mut(key).and_then(Value::as_array_mut) else {
+            continue;
+        };
+        for item in items.iter_mut().filter_map(Value::as_object_mut) {
+            match key {
+                "scenes" => {
+                    item.entry("nodes")
+                        .or_insert_with(|| Value::Array(Vec::new()));
+                }
+                _ => {
+                    item.entry("source").or_insert(Value::from(u32::MAX));
+                }
+            }
+        }
+    }
+    use serde::Deserialize;
+    json::Root::deserialize(&v).map_err(|e| {
+        let at = locate_error(&v).unwrap_or_else(|| e.to_string());
+        LoadError::new(
+            LoadErrorKind::Format,
+            format!("not a valid glTF 2.0 document: {at}"),
+        )
+    })
+}
+
+/// Finds the first top-level array element the `gltf` crate refuses, for a message with
+/// a JSON path (`accessors[3]: missing field `count``).
+fn locate_error(v: &Value) -> Option<String> {
+    use serde::Deserialize;
+    fn first_bad<T: for<'de> Deserialize<'de>>(v: &Value, key: &str) -> Option<String> {
+        let items = member(v, key)?;
+        let Some(items) = items.as_array() else {
+            return Some(format!("`{key}` is not an array"));
+        };
+        items.iter().enumerate().find_map(|(i, item)| {
+            T::deserialize(item)
+                .err()
+                .map(|e| format!("{key}[{i}]: {e}"))
+        })
+    }
+    if member(v, "asset").is_none() {
+        return Some("missing field `asset` (not a glTF document?)".into());
+    }
+    json::Asset::deserialize(&v["asset"])
+        .err()
+        .map(|e| format!("asset: {e}"))
+        .or_else(|| first_bad::<json::Accessor>(v, "accessors"))
+        .or_else(|| first_bad::<json::Buffer>(v, "buffers"))
+        .or_else(|| first_bad::<json::buffer::View>(v, "bufferViews"))
+        .or_else(|| first_bad::<json::Camera>(v, "cameras"))
+        .or_else(|| first_bad::<json::Image>(v, "images"))
+        .or_else(|| first_bad::<json::Material>(v, "materials"))
+        .or_else(|| first_bad::<json::Mesh>(v, "meshes"))
+        .or_else(|| first_bad::<json::Node>(v, "nodes"))
+        .or_else(|| first_bad::<json::texture::Sampler>(v, "samplers"))
+        .or_else(|| first_bad::<json::Scene>(v, "scenes"))
+        .or_else(|| first_bad::<json::Texture>(v, "textures"))
 }
 
 /// Fetches every buffer, trimmed to its `byteLength`.

@@ -541,3 +541,51 @@ fn texture_transform_is_accepted_with_one_warning() {
     );
     assert_eq!(s.images[0].rgba8, vec![[10, 20, 30, 255]; 2]);
 }
+
+#[test]
+fn scenes_without_nodes_and_empty_documents() {
+    for doc in [
+        json!({ "asset": { "version": "2.0" }, "scenes": [{}] }),
+        json!({ "asset": { "version": "2.0" }, "scene": 0, "scenes": [{ "name": "x" }], "extensionsUsed": ["TESELA_world"],
+                "extensions": { "TESELA_world": { "color": [0.5, 0.5, 0.5], "strength": 1.0 } } }),
+        json!({ "asset": { "version": "2.0" }, "nodes": [{ "children": [1] }, {}] }),
+    ] {
+        let s = load(&serde_json::to_vec(&doc).unwrap());
+        assert_eq!(s.triangle_count(), 0);
+    }
+}
+
+#[test]
+fn typed_errors_carry_a_json_path_and_unused_parts_are_not_checked() {
+    let mut b = Bin::default();
+    let p = b.vec3(&[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]]);
+    let doc = json!({
+        "nodes": [{ "mesh": 0 }],
+        "meshes": [{ "primitives": [{ "attributes": { "POSITION": p }, "material": 0 }] }],
+        "materials": [{ "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 } } }],
+        "textures": [{ "extensions": { "EXT_texture_webp": { "source": 0 } } }],
+        "animations": [{ "channels": "garbage" }],
+        "skins": [{ "joints": "garbage" }],
+        "extras": { "anything": [1, 2, 3] }
+    });
+    let mut d: Value = serde_json::from_slice(&b.finish(doc)).unwrap();
+    let s = load(&serde_json::to_vec(&d).unwrap());
+    assert_eq!(s.triangle_count(), 1);
+    assert!(s.materials[0].base_color_texture.is_none());
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    assert!(s.warnings[0].contains("texture 0 has no `source`"));
+
+    d["accessors"][0].as_object_mut().unwrap().remove("count");
+    let e = load_from_slice(&serde_json::to_vec(&d).unwrap(), None, "x.gltf").unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "x.gltf: not a valid glTF 2.0 document: accessors[0]: missing field `count`"
+    );
+    d["accessors"][0]["count"] = json!(3);
+    d["nodes"][0]["mesh"] = json!("zero");
+    let e = load_from_slice(&serde_json::to_vec(&d).unwrap(), None, "x.gltf").unwrap_err();
+    assert!(
+        e.to_string().contains("nodes[0]: invalid type: string"),
+        "{e}"
+    );
+}
