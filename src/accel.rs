@@ -110,7 +110,7 @@ impl Accel {
         if self.tris.is_empty() {
             return None;
         }
-        let ray = BvhRay::new(o.into(), d.into(), tmin, tmax);
+        let ray = BvhRay::new(o.into(), positive_zeros(d).into(), tmin, tmax);
         let mut hit = RayHit::none();
         let (mut bu, mut bv) = (0.0, 0.0);
         let tris = &self.tris;
@@ -138,7 +138,7 @@ impl Accel {
         if self.tris.is_empty() {
             return false;
         }
-        let ray = BvhRay::new(o.into(), d.into(), tmin, tmax);
+        let ray = BvhRay::new(o.into(), positive_zeros(d).into(), tmin, tmax);
         let tris = &self.tris;
         !self.bvh.ray_traverse_miss(ray, |r, id| {
             match intersect_triangle(&tris[id], r.origin, r.direction, r.tmin, r.tmax) {
@@ -147,6 +147,13 @@ impl Accel {
             }
         })
     }
+}
+
+/// Replaces `-0.0` components by `+0.0`: obvhs takes the traversal octant from the sign test
+/// `< 0` but inverts `-0.0` to `-1/ε`, so a direction with a negative zero misses everything.
+#[inline(always)]
+fn positive_zeros(d: Vec3) -> Vec3 {
+    d + Vec3::ZERO
 }
 
 /// Moves a surface point off its surface along the geometric normal `ng` to the side of `w`,
@@ -183,7 +190,11 @@ mod tests {
         assert!(h.triangle < 2, "nearest quad is the first one");
         assert!(accel.occluded(Vec3::new(0.2, 0.3, 5.0), -Vec3::Z, 0.0, 6.0));
         assert!(!accel.occluded(Vec3::new(0.2, 0.3, 5.0), -Vec3::Z, 0.0, 4.9));
-        assert!(accel.intersect(Vec3::new(3.0, 0.0, 5.0), -Vec3::Z, 0.0, f32::INFINITY).is_none());
+        assert!(
+            accel
+                .intersect(Vec3::new(3.0, 0.0, 5.0), -Vec3::Z, 0.0, f32::INFINITY)
+                .is_none()
+        );
     }
 
     #[test]
@@ -193,7 +204,27 @@ mod tests {
         for i in 0..1000 {
             let s = -0.99 + 1.98 * i as f32 / 999.0;
             let o = Vec3::new(s, s, 1.0);
-            assert!(accel.intersect(o, -Vec3::Z, 0.0, 10.0).is_some(), "gap at {s}");
+            assert!(
+                accel.intersect(o, -Vec3::Z, 0.0, 10.0).is_some(),
+                "gap at {s}"
+            );
+        }
+    }
+
+    #[test]
+    fn negative_zero_direction_components_hit() {
+        let accel = Accel::build(&quad(0.0));
+        for d in [
+            Vec3::new(-0.0, 0.0, -1.0),
+            Vec3::new(0.0, -0.0, -1.0),
+            Vec3::new(-0.0, -0.0, -1.0),
+        ] {
+            assert!(
+                accel
+                    .intersect(Vec3::new(0.3, 0.2, 1.0), d, 0.0, 10.0)
+                    .is_some()
+            );
+            assert!(accel.occluded(Vec3::new(0.3, 0.2, 1.0), d, 0.0, 10.0));
         }
     }
 

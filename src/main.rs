@@ -149,12 +149,18 @@ fn load_scene(args: &RenderArgs) -> Result<Scene, String> {
 
 fn options(args: &RenderArgs, scene: &Scene) -> RenderOptions {
     let s = &scene.settings;
-    let aspect = scene.camera.and_then(|c| c.aspect).filter(|a| a.is_finite() && *a > 0.0);
+    let aspect = scene
+        .camera
+        .and_then(|c| c.aspect)
+        .filter(|a| a.is_finite() && *a > 0.0);
     let width = args.width.or(s.width).unwrap_or(512);
-    let height = args.height.or(s.height).unwrap_or_else(|| match (args.width.or(s.width), aspect) {
-        (_, Some(a)) => ((width as f32 / a).round() as u32).max(1),
-        _ => width,
-    });
+    let height =
+        args.height
+            .or(s.height)
+            .unwrap_or_else(|| match (args.width.or(s.width), aspect) {
+                (_, Some(a)) => ((width as f32 / a).round() as u32).max(1),
+                _ => width,
+            });
     RenderOptions {
         width,
         height,
@@ -247,7 +253,9 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
                 send(&Message::Error(e));
                 return ExitCode::from(EXIT_RENDER);
             }
-            send(&Message::Done(serde_json::to_string(&stats).unwrap_or_default()));
+            send(&Message::Done(
+                serde_json::to_string(&stats).unwrap_or_default(),
+            ));
             ExitCode::SUCCESS
         }
         Err(RenderError::Cancelled) => {
@@ -282,7 +290,10 @@ fn run_render(args: &RenderArgs) -> ExitCode {
         eprintln!("tesela: error: {e}");
         return ExitCode::from(EXIT_RENDER);
     }
-    let output = args.output.clone().unwrap_or_else(|| PathBuf::from("tesela.png"));
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("tesela.png"));
     if let Err(e) = check_output(&output) {
         eprintln!("tesela: error: {e}");
         return ExitCode::from(EXIT_RENDER);
@@ -355,7 +366,11 @@ fn run_render(args: &RenderArgs) -> ExitCode {
 
 /// Refuses an output path whose format is unknown before spending time on the render.
 fn check_output(path: &Path) -> Result<(), String> {
-    match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()) {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+    {
         Some(e) if e == "png" || e == "exr" => Ok(()),
         _ => Err(format!(
             "{}: unknown output format (use a .exr or .png file name)",
@@ -368,12 +383,23 @@ fn run_info(path: &Path) -> ExitCode {
     match scene::gltf::load(path) {
         Ok(s) => {
             println!("{}", path.display());
-            println!("  meshes: {}, triangles: {}", s.meshes.len(), s.triangle_count());
+            println!(
+                "  meshes: {}, triangles: {}",
+                s.meshes.len(),
+                s.triangle_count()
+            );
             println!("  materials: {}", s.materials.len());
             for m in &s.materials {
                 println!(
                     "    {}: base {:?} metallic {} roughness {} emission {:?} transmission {} ior {} specular {}",
-                    m.name, m.base_color, m.metallic, m.roughness, m.emission, m.transmission, m.ior, m.specular
+                    m.name,
+                    m.base_color,
+                    m.metallic,
+                    m.roughness,
+                    m.emission,
+                    m.transmission,
+                    m.ior,
+                    m.specular
                 );
             }
             println!("  lights: {}", s.lights.len());

@@ -6,7 +6,11 @@ use std::path::Path;
 /// sRGB transfer function (encode) of a linear value, clamped to [0, 1].
 #[inline]
 pub fn srgb_encode(c: f32) -> f32 {
-    let c = if c.is_finite() { c.clamp(0.0, 1.0) } else { 0.0 };
+    let c = if c.is_finite() {
+        c.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     if c <= 0.003_130_8 {
         12.92 * c
     } else {

@@ -246,7 +246,12 @@ mod tests {
         assert!(read(&mut &buf[..buf.len() - 1]).is_err());
         assert!(read(&mut &buf[..5]).is_err());
         let mut hello = Vec::new();
-        frame(&mut hello, HELLO, b"XXXX\x01\0\0\0\x01\0\0\0\x01\0\0\0\x01\0\0\0\x01\0\0\0").unwrap();
+        frame(
+            &mut hello,
+            HELLO,
+            b"XXXX\x01\0\0\0\x01\0\0\0\x01\0\0\0\x01\0\0\0\x01\0\0\0",
+        )
+        .unwrap();
         let e = read(&mut &hello[..]).unwrap_err();
         assert!(e.to_string().contains("bad magic"));
     }

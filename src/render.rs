@@ -94,7 +94,9 @@ pub const MAX_PIXELS: u64 = 1 << 28;
 /// Checks the options before any allocation.
 pub fn validate(opts: &RenderOptions) -> Result<(), RenderError> {
     if opts.width == 0 || opts.height == 0 {
-        return Err(RenderError::Invalid("resolution must be at least 1x1".into()));
+        return Err(RenderError::Invalid(
+            "resolution must be at least 1x1".into(),
+        ));
     }
     if opts.width as u64 * opts.height as u64 > MAX_PIXELS {
         return Err(RenderError::Invalid(format!(
@@ -103,7 +105,9 @@ pub fn validate(opts: &RenderOptions) -> Result<(), RenderError> {
         )));
     }
     if opts.spp == 0 {
-        return Err(RenderError::Invalid("samples per pixel must be at least 1".into()));
+        return Err(RenderError::Invalid(
+            "samples per pixel must be at least 1".into(),
+        ));
     }
     if integrator::by_name(&opts.integrator, 1).is_none() {
         return Err(RenderError::Invalid(format!(

@@ -243,7 +243,12 @@ impl RenderScene {
     /// Radiance emitted by the hit surface towards `-d` (for a ray travelling along `d`),
     /// with the emitter's index for MIS.
     #[inline]
-    pub fn emitted(&self, its: &Intersection, d: Vec3, from: Vec3) -> Option<(u32, Vec3, EmitterQueryRecord)> {
+    pub fn emitted(
+        &self,
+        its: &Intersection,
+        d: Vec3,
+        from: Vec3,
+    ) -> Option<(u32, Vec3, EmitterQueryRecord)> {
         let e = its.emitter?;
         let rec = EmitterQueryRecord::between(from, its.p, its.ns, its.ng, its.uv);
         let _ = d;
@@ -253,7 +258,11 @@ impl RenderScene {
 
     /// Background radiance for a ray leaving the scene along `d` from `from`.
     #[inline]
-    pub fn background_radiance(&self, d: Vec3, from: Vec3) -> Option<(u32, Vec3, EmitterQueryRecord)> {
+    pub fn background_radiance(
+        &self,
+        d: Vec3,
+        from: Vec3,
+    ) -> Option<(u32, Vec3, EmitterQueryRecord)> {
         let b = self.background?;
         let rec = EmitterQueryRecord::towards(from, d);
         Some((b, self.emitters[b as usize].eval(&self.scene, &rec), rec))
@@ -269,7 +278,12 @@ impl RenderScene {
     /// Chooses an emitter and samples it from `ref_p`. Returns the record and the weight
     /// `Le / (pmf · pdf)` (zero when no light could be sampled).
     #[inline]
-    pub fn sample_light(&self, ref_p: Vec3, u_choice: f32, u: Vec2) -> (u32, EmitterQueryRecord, Vec3) {
+    pub fn sample_light(
+        &self,
+        ref_p: Vec3,
+        u_choice: f32,
+        u: Vec2,
+    ) -> (u32, EmitterQueryRecord, Vec3) {
         let mut rec = EmitterQueryRecord::from_ref(ref_p);
         if self.lights.is_empty() {
             return (0, rec, Vec3::ZERO);

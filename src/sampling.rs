@@ -95,7 +95,11 @@ impl DiscreteCdf {
         let mut cdf = vec![0.0f32];
         let mut raw = vec![0.0f64];
         for w in weights {
-            let w = if w.is_finite() && w > 0.0 { w as f64 } else { 0.0 };
+            let w = if w.is_finite() && w > 0.0 {
+                w as f64
+            } else {
+                0.0
+            };
             acc += w;
             raw.push(acc);
         }
@@ -144,9 +148,7 @@ impl DiscreteCdf {
     pub fn sample_reuse(&self, u: f32) -> (usize, f32) {
         let n = self.len();
         // First index with cdf[i+1] > u.
-        let i = self.cdf[1..]
-            .partition_point(|&c| c <= u)
-            .min(n - 1);
+        let i = self.cdf[1..].partition_point(|&c| c <= u).min(n - 1);
         // Skip zero-weight items at the end that rounding could land on.
         let mut i = i;
         while self.pmf(i) <= 0.0 && i > 0 {

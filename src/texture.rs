@@ -87,7 +87,12 @@ mod tests {
         Image {
             width: 2,
             height: 2,
-            rgba8: vec![[255, 0, 0, 255], [0, 255, 0, 255], [0, 0, 255, 255], [255, 255, 255, 255]],
+            rgba8: vec![
+                [255, 0, 0, 255],
+                [0, 255, 0, 255],
+                [0, 0, 255, 255],
+                [255, 255, 255, 255],
+            ],
         }
     }
 
@@ -101,11 +106,20 @@ mod tests {
             nearest: false,
         };
         let c = lookup(&tex, &img, Vec2::new(0.25, 0.25), false);
-        assert!((c - Vec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-6, "top-left texel");
+        assert!(
+            (c - Vec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-6,
+            "top-left texel"
+        );
         let c = lookup(&tex, &img, Vec2::new(1.25, 0.75), false);
-        assert!((c - Vec4::new(0.0, 0.0, 1.0, 1.0)).length() < 1e-6, "repeat");
+        assert!(
+            (c - Vec4::new(0.0, 0.0, 1.0, 1.0)).length() < 1e-6,
+            "repeat"
+        );
         let mid = lookup(&tex, &img, Vec2::new(0.5, 0.25), false);
-        assert!((mid - Vec4::new(0.5, 0.5, 0.0, 1.0)).length() < 1e-6, "bilinear");
+        assert!(
+            (mid - Vec4::new(0.5, 0.5, 0.0, 1.0)).length() < 1e-6,
+            "bilinear"
+        );
         let s = lookup(&tex, &img, Vec2::new(0.75, 0.75), true);
         assert!((s.x - 1.0).abs() < 1e-6);
         let half = srgb_table()[128];

@@ -17,7 +17,11 @@ pub struct Dielectric {
 
 impl Dielectric {
     pub fn new(ior: f32, tint: Vec3) -> Self {
-        let ior = if ior.is_finite() && ior > 0.0 { ior } else { 1.5 };
+        let ior = if ior.is_finite() && ior > 0.0 {
+            ior
+        } else {
+            1.5
+        };
         Dielectric { ior, tint }
     }
 }
@@ -38,11 +42,7 @@ impl Bsdf for Dielectric {
         } else {
             // Refraction: wo = -wi / eta + n (cos_i / eta - cos_t), with n on wi's side.
             let sign = cos_i.signum();
-            let wo = Vec3::new(
-                -rec.wi.x / eta,
-                -rec.wi.y / eta,
-                -sign * cos_t,
-            );
+            let wo = Vec3::new(-rec.wi.x / eta, -rec.wi.y / eta, -sign * cos_t);
             rec.wo = wo.normalize();
             rec.eta = eta;
             self.tint / (eta * eta)

@@ -80,7 +80,10 @@ mod tests {
             let (r, cos_t, eta) = dielectric(theta_i.cos(), 1.33);
             assert!((0.0..=1.0).contains(&r));
             let sin_t = (1.0 - cos_t * cos_t).sqrt();
-            assert!((theta_i.sin() - eta * sin_t).abs() < 1e-4, "Snell at {k} deg");
+            assert!(
+                (theta_i.sin() - eta * sin_t).abs() < 1e-4,
+                "Snell at {k} deg"
+            );
         }
         assert!(dielectric(1e-4, 1.5).0 > 0.99);
     }

@@ -25,10 +25,7 @@ impl Plastic {
     pub fn new(base: Vec3, alpha: f32, ior: f32, specular: f32, specular_color: Vec3) -> Self {
         let m = specular_color.max_element();
         let (f0, tint) = if m > 0.0 {
-            (
-                (fresnel::f0_from_ior(ior) * m).min(1.0),
-                specular_color / m,
-            )
+            ((fresnel::f0_from_ior(ior) * m).min(1.0), specular_color / m)
         } else {
             (0.0, Vec3::ONE)
         };

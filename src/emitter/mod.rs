@@ -191,6 +191,10 @@ impl LightSampler {
     /// Probability of choosing emitter `i`.
     #[inline]
     pub fn pmf(&self, i: usize) -> f32 {
-        if self.cdf.is_empty() { 0.0 } else { self.cdf.pmf(i) }
+        if self.cdf.is_empty() {
+            0.0
+        } else {
+            self.cdf.pmf(i)
+        }
     }
 }

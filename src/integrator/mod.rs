@@ -100,7 +100,12 @@ impl ShadingPoint {
 
     /// Samples the BSDF: `(world direction, weight, record)`, or `None` if it failed.
     #[inline]
-    pub fn sample(&self, ctx: &mut Ctx, its: &Intersection, d: Vec3) -> Option<(Vec3, Vec3, BsdfQueryRecord)> {
+    pub fn sample(
+        &self,
+        ctx: &mut Ctx,
+        its: &Intersection,
+        d: Vec3,
+    ) -> Option<(Vec3, Vec3, BsdfQueryRecord)> {
         let mut rec = BsdfQueryRecord::new(self.wi);
         let u = ctx.sampler.next_2d();
         let u1 = ctx.sampler.next_1d();

@@ -42,7 +42,14 @@ pub fn quad(name: &str, material: usize, a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> 
 }
 
 /// A UV sphere with smooth normals (outward) and `rings × segments` quads.
-pub fn sphere(name: &str, material: usize, center: Vec3, radius: f32, rings: u32, segments: u32) -> Mesh {
+pub fn sphere(
+    name: &str,
+    material: usize,
+    center: Vec3,
+    radius: f32,
+    rings: u32,
+    segments: u32,
+) -> Mesh {
     let mut m = Mesh {
         name: name.into(),
         material,
@@ -52,11 +59,17 @@ pub fn sphere(name: &str, material: usize, center: Vec3, radius: f32, rings: u32
         let theta = PI * r as f32 / rings as f32;
         for s in 0..=segments {
             let phi = 2.0 * PI * s as f32 / segments as f32;
-            let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+            let n = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                -theta.sin() * phi.sin(),
+            );
             m.positions.push(center + n * radius);
             m.normals.push(n);
-            m.uvs
-                .push(Vec2::new(s as f32 / segments as f32, r as f32 / rings as f32));
+            m.uvs.push(Vec2::new(
+                s as f32 / segments as f32,
+                r as f32 / rings as f32,
+            ));
         }
     }
     let row = segments + 1;
@@ -122,22 +135,73 @@ pub fn look_at(eye: Vec3, target: Vec3) -> Mat4 {
 
 /// The empty Cornell box (walls, light), 1 m wide, open towards +Z, camera on +Z.
 fn cornell_shell(scene: &mut Scene) {
-    let white = add_material(scene, Material::diffuse("white", Vec3::new(0.725, 0.71, 0.68)));
-    let red = add_material(scene, Material::diffuse("red", Vec3::new(0.63, 0.065, 0.05)));
-    let green = add_material(scene, Material::diffuse("green", Vec3::new(0.14, 0.45, 0.091)));
+    let white = add_material(
+        scene,
+        Material::diffuse("white", Vec3::new(0.725, 0.71, 0.68)),
+    );
+    let red = add_material(
+        scene,
+        Material::diffuse("red", Vec3::new(0.63, 0.065, 0.05)),
+    );
+    let green = add_material(
+        scene,
+        Material::diffuse("green", Vec3::new(0.14, 0.45, 0.091)),
+    );
     let light = add_material(
         scene,
         Material::emitter("light", Vec3::new(17.0, 12.0, 4.0), false),
     );
     let (l, r, b, t, back, front) = (-0.5, 0.5, 0.0, 1.0, -0.5, 0.5);
     let v = Vec3::new;
-    scene.meshes.push(quad("floor", white, v(l, b, front), v(r, b, front), v(r, b, back), v(l, b, back)));
-    scene.meshes.push(quad("ceiling", white, v(l, t, back), v(r, t, back), v(r, t, front), v(l, t, front)));
-    scene.meshes.push(quad("back", white, v(l, b, back), v(r, b, back), v(r, t, back), v(l, t, back)));
-    scene.meshes.push(quad("left", red, v(l, b, front), v(l, b, back), v(l, t, back), v(l, t, front)));
-    scene.meshes.push(quad("right", green, v(r, b, back), v(r, b, front), v(r, t, front), v(r, t, back)));
+    scene.meshes.push(quad(
+        "floor",
+        white,
+        v(l, b, front),
+        v(r, b, front),
+        v(r, b, back),
+        v(l, b, back),
+    ));
+    scene.meshes.push(quad(
+        "ceiling",
+        white,
+        v(l, t, back),
+        v(r, t, back),
+        v(r, t, front),
+        v(l, t, front),
+    ));
+    scene.meshes.push(quad(
+        "back",
+        white,
+        v(l, b, back),
+        v(r, b, back),
+        v(r, t, back),
+        v(l, t, back),
+    ));
+    scene.meshes.push(quad(
+        "left",
+        red,
+        v(l, b, front),
+        v(l, b, back),
+        v(l, t, back),
+        v(l, t, front),
+    ));
+    scene.meshes.push(quad(
+        "right",
+        green,
+        v(r, b, back),
+        v(r, b, front),
+        v(r, t, front),
+        v(r, t, back),
+    ));
     let (s, y) = (0.12, t - 0.001);
-    scene.meshes.push(quad("light", light, v(-s, y, -s), v(s, y, -s), v(s, y, s), v(-s, y, s)));
+    scene.meshes.push(quad(
+        "light",
+        light,
+        v(-s, y, -s),
+        v(s, y, -s),
+        v(s, y, s),
+        v(-s, y, s),
+    ));
     scene.camera = Some(Camera {
         projection: Projection::Perspective {
             yfov: 39.3f32.to_radians(),
@@ -152,8 +216,20 @@ pub fn cornell_box() -> Scene {
     let mut scene = Scene::default();
     cornell_shell(&mut scene);
     let white = 0;
-    scene.meshes.push(block("tall block", white, Vec3::new(-0.17, 0.0, -0.15), Vec3::new(0.3, 0.6, 0.3), 0.3));
-    scene.meshes.push(block("short block", white, Vec3::new(0.18, 0.0, 0.12), Vec3::new(0.3, 0.3, 0.3), -0.3));
+    scene.meshes.push(block(
+        "tall block",
+        white,
+        Vec3::new(-0.17, 0.0, -0.15),
+        Vec3::new(0.3, 0.6, 0.3),
+        0.3,
+    ));
+    scene.meshes.push(block(
+        "short block",
+        white,
+        Vec3::new(0.18, 0.0, 0.12),
+        Vec3::new(0.3, 0.3, 0.3),
+        -0.3,
+    ));
     scene
 }
 
@@ -163,8 +239,22 @@ pub fn cornell_spheres() -> Scene {
     cornell_shell(&mut scene);
     let mirror = add_material(&mut scene, Material::mirror("mirror", Vec3::ONE));
     let glass = add_material(&mut scene, Material::glass("glass", 1.5));
-    scene.meshes.push(sphere("mirror sphere", mirror, Vec3::new(-0.2, 0.2, -0.15), 0.2, 48, 96));
-    scene.meshes.push(sphere("glass sphere", glass, Vec3::new(0.2, 0.2, 0.15), 0.2, 48, 96));
+    scene.meshes.push(sphere(
+        "mirror sphere",
+        mirror,
+        Vec3::new(-0.2, 0.2, -0.15),
+        0.2,
+        48,
+        96,
+    ));
+    scene.meshes.push(sphere(
+        "glass sphere",
+        glass,
+        Vec3::new(0.2, 0.2, 0.15),
+        0.2,
+        48,
+        96,
+    ));
     scene
 }
 
@@ -174,12 +264,32 @@ pub fn glass_pane() -> Scene {
     let mut scene = Scene::default();
     let floor = add_material(&mut scene, Material::diffuse("floor", Vec3::splat(0.6)));
     let dark = add_material(&mut scene, Material::diffuse("wall", Vec3::splat(0.1)));
-    let warm = add_material(&mut scene, Material::emitter("warm", Vec3::new(6.0, 3.0, 1.0), false));
-    let cool = add_material(&mut scene, Material::emitter("cool", Vec3::new(1.0, 2.5, 6.0), false));
+    let warm = add_material(
+        &mut scene,
+        Material::emitter("warm", Vec3::new(6.0, 3.0, 1.0), false),
+    );
+    let cool = add_material(
+        &mut scene,
+        Material::emitter("cool", Vec3::new(1.0, 2.5, 6.0), false),
+    );
     let glass = add_material(&mut scene, Material::glass("glass", 1.5));
     let v = Vec3::new;
-    scene.meshes.push(quad("floor", floor, v(-2.0, 0.0, 2.0), v(2.0, 0.0, 2.0), v(2.0, 0.0, -2.0), v(-2.0, 0.0, -2.0)));
-    scene.meshes.push(quad("wall", dark, v(-2.0, 0.0, -1.0), v(2.0, 0.0, -1.0), v(2.0, 2.0, -1.0), v(-2.0, 2.0, -1.0)));
+    scene.meshes.push(quad(
+        "floor",
+        floor,
+        v(-2.0, 0.0, 2.0),
+        v(2.0, 0.0, 2.0),
+        v(2.0, 0.0, -2.0),
+        v(-2.0, 0.0, -2.0),
+    ));
+    scene.meshes.push(quad(
+        "wall",
+        dark,
+        v(-2.0, 0.0, -1.0),
+        v(2.0, 0.0, -1.0),
+        v(2.0, 2.0, -1.0),
+        v(-2.0, 2.0, -1.0),
+    ));
     for i in 0..6 {
         let x0 = -1.5 + i as f32 * 0.5;
         let m = if i % 2 == 0 { warm } else { cool };
@@ -197,7 +307,12 @@ pub fn glass_pane() -> Scene {
     // The block helper leaves out the bottom face; close the slab with it.
     let h = v(0.6, 0.0, 0.02);
     let bi = pane.positions.len() as u32;
-    pane.positions.extend([v(-h.x, 0.0, -h.z), v(h.x, 0.0, -h.z), v(h.x, 0.0, h.z), v(-h.x, 0.0, h.z)]);
+    pane.positions.extend([
+        v(-h.x, 0.0, -h.z),
+        v(h.x, 0.0, -h.z),
+        v(h.x, 0.0, h.z),
+        v(-h.x, 0.0, h.z),
+    ]);
     pane.normals.extend([-Vec3::Y; 4]);
     pane.indices.push([bi, bi + 1, bi + 2]);
     pane.indices.push([bi, bi + 2, bi + 3]);

@@ -31,7 +31,8 @@ impl Buffer {
     fn floats(&mut self, values: &[f32], kind: &str, count: usize, minmax: bool) -> usize {
         let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
         let view = self.push(&bytes, 34962);
-        let mut acc = json!({"bufferView": view, "componentType": 5126, "count": count, "type": kind});
+        let mut acc =
+            json!({"bufferView": view, "componentType": 5126, "count": count, "type": kind});
         if minmax && count > 0 {
             let mut lo = [f32::INFINITY; 3];
             let mut hi = [f32::NEG_INFINITY; 3];
@@ -106,19 +107,31 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), String> {
             let (emissive, strength) = color_strength(m.emission);
             let mut ext = serde_json::Map::new();
             if strength != 1.0 {
-                ext.insert("KHR_materials_emissive_strength".into(), json!({"emissiveStrength": strength}));
+                ext.insert(
+                    "KHR_materials_emissive_strength".into(),
+                    json!({"emissiveStrength": strength}),
+                );
             }
             if m.transmission > 0.0 {
-                ext.insert("KHR_materials_transmission".into(), json!({"transmissionFactor": m.transmission}));
+                ext.insert(
+                    "KHR_materials_transmission".into(),
+                    json!({"transmissionFactor": m.transmission}),
+                );
             }
             if m.ior != 1.5 {
                 ext.insert("KHR_materials_ior".into(), json!({"ior": m.ior}));
             }
             if m.specular != 1.0 {
-                ext.insert("KHR_materials_specular".into(), json!({"specularFactor": m.specular}));
+                ext.insert(
+                    "KHR_materials_specular".into(),
+                    json!({"specularFactor": m.specular}),
+                );
             }
             if m.is_emissive() {
-                ext.insert("TESELA_emission".into(), json!({"two_sided": m.emission_two_sided}));
+                ext.insert(
+                    "TESELA_emission".into(),
+                    json!({"two_sided": m.emission_two_sided}),
+                );
             }
             json!({
                 "name": m.name,
@@ -136,25 +149,46 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), String> {
     let mut lights = Vec::new();
     for l in &scene.lights {
         let (node, light) = match *l {
-            Light::Point { position, intensity } => {
+            Light::Point {
+                position,
+                intensity,
+            } => {
                 let (c, s) = color_strength(intensity);
-                (json!({"translation": position.to_array()}),
-                 json!({"type": "point", "color": c, "intensity": s * LUMENS_PER_WATT}))
+                (
+                    json!({"translation": position.to_array()}),
+                    json!({"type": "point", "color": c, "intensity": s * LUMENS_PER_WATT}),
+                )
             }
-            Light::Spot { position, direction, intensity, falloff } => {
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                falloff,
+            } => {
                 let (c, s) = color_strength(intensity);
                 let (inner, outer) = match falloff {
-                    SpotFalloff::Gltf { cos_inner, cos_outer } => (cos_inner.acos(), cos_outer.acos()),
+                    SpotFalloff::Gltf {
+                        cos_inner,
+                        cos_outer,
+                    } => (cos_inner.acos(), cos_outer.acos()),
                     SpotFalloff::Cycles { cos_half, .. } => (0.0, cos_half.acos()),
                 };
-                (json!({"translation": position.to_array(), "rotation": rotation_to(direction)}),
-                 json!({"type": "spot", "color": c, "intensity": s * LUMENS_PER_WATT,
-                        "spot": {"innerConeAngle": inner, "outerConeAngle": outer}}))
+                (
+                    json!({"translation": position.to_array(), "rotation": rotation_to(direction)}),
+                    json!({"type": "spot", "color": c, "intensity": s * LUMENS_PER_WATT,
+                        "spot": {"innerConeAngle": inner, "outerConeAngle": outer}}),
+                )
             }
-            Light::Directional { direction, irradiance, .. } => {
+            Light::Directional {
+                direction,
+                irradiance,
+                ..
+            } => {
                 let (c, s) = color_strength(irradiance);
-                (json!({"rotation": rotation_to(direction)}),
-                 json!({"type": "directional", "color": c, "intensity": s * LUMENS_PER_WATT}))
+                (
+                    json!({"rotation": rotation_to(direction)}),
+                    json!({"type": "directional", "color": c, "intensity": s * LUMENS_PER_WATT}),
+                )
             }
         };
         lights.push(light);
@@ -179,8 +213,13 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), String> {
         nodes.push(json!({"name": "camera", "camera": 0, "matrix": m}));
     }
     let mut root_ext = serde_json::Map::new();
-    let mut used = vec!["KHR_materials_emissive_strength", "KHR_materials_transmission",
-        "KHR_materials_ior", "KHR_materials_specular", "TESELA_emission"];
+    let mut used = vec![
+        "KHR_materials_emissive_strength",
+        "KHR_materials_transmission",
+        "KHR_materials_ior",
+        "KHR_materials_specular",
+        "TESELA_emission",
+    ];
     if !lights.is_empty() {
         root_ext.insert("KHR_lights_punctual".into(), json!({"lights": lights}));
         used.push("KHR_lights_punctual");
