@@ -1,8 +1,11 @@
 //! Ideal (smooth) dielectric interface: Fresnel-weighted choice between specular reflection and
 //! refraction, for rays entering (`wi.z > 0`) and leaving (`wi.z < 0`), with total internal
-//! reflection. Transmission is tinted by the base colour (glTF) and carries the radiance scale
-//! `1/η²` (η = `η_t/η_i`), so radiance is compressed when entering a denser medium and expanded
-//! again when leaving it.
+//! reflection.
+//!
+//! Matching Cycles (measured, docs/blender-units.md): each refraction is tinted by
+//! `sqrt(base colour)`, so a ray through a closed solid is tinted by the base colour once, and no
+//! `1/η²` radiance scaling is applied (for closed meshes it cancels anyway; it would only show
+//! with open sheets or a camera inside glass).
 
 use super::{Bsdf, BsdfQueryRecord, Measure, fresnel};
 use glam::{Vec2, Vec3};
@@ -11,7 +14,7 @@ use glam::{Vec2, Vec3};
 pub struct Dielectric {
     /// `η_inside / η_outside`.
     pub ior: f32,
-    /// Transmission tint.
+    /// Per-refraction transmission tint: `sqrt(base colour)`.
     pub tint: Vec3,
 }
 
@@ -22,7 +25,10 @@ impl Dielectric {
         } else {
             1.5
         };
-        Dielectric { ior, tint }
+        Dielectric {
+            ior,
+            tint: tint.max(Vec3::ZERO).map(f32::sqrt),
+        }
     }
 }
 
@@ -45,7 +51,7 @@ impl Bsdf for Dielectric {
             let wo = Vec3::new(-rec.wi.x / eta, -rec.wi.y / eta, -sign * cos_t);
             rec.wo = wo.normalize();
             rec.eta = eta;
-            self.tint / (eta * eta)
+            self.tint
         }
     }
 

@@ -150,7 +150,8 @@ pub struct SurfaceParams {
 /// - transmission → [`Dielectric`] (ideal; roughness is ignored for transmission),
 /// - metal → [`Mirror`] (alpha below [`DELTA_ALPHA`]) or [`RoughConductor`] (GGX),
 /// - dielectric base → [`Plastic`] (GGX or smooth coat over Lambert) or [`Diffuse`] when
-///   `specular` is 0 (Blender's Specular IOR Level 0).
+///   `specular · max(specular colour)` is 0 (Blender's Specular IOR Level 0: 4.x writes
+///   `specularFactor: 0`, 3.x `specularColorFactor: [0, 0, 0]`).
 pub fn choose(p: &SurfaceParams, u: f32) -> BsdfInstance {
     let alpha = (p.roughness * p.roughness).clamp(0.0, 1.0);
     let transmission = p.transmission.clamp(0.0, 1.0) * (1.0 - p.metallic.clamp(0.0, 1.0));
@@ -169,7 +170,7 @@ pub fn choose(p: &SurfaceParams, u: f32) -> BsdfInstance {
         } else {
             BsdfInstance::RoughConductor(RoughConductor::new(p.base_color, alpha))
         }
-    } else if p.specular <= 0.0 {
+    } else if p.specular * p.specular_color.max_element() <= 0.0 {
         BsdfInstance::Diffuse(Diffuse::new(p.base_color))
     } else {
         BsdfInstance::Plastic(Plastic::new(

@@ -1,7 +1,6 @@
 //! Unidirectional path tracing: `path_mats` (BSDF sampling only) and `path_mis` (emitter and
 //! BSDF sampling at every vertex, power heuristic). Russian roulette from vertex 4 on, on the
-//! throughput's **maximum** component (times the accumulated `η²` of refractions, so radiance
-//! scaling inside glass does not kill paths), survival probability capped at 0.95.
+//! throughput's **maximum** component, survival probability capped at 0.95.
 
 use super::{Integrator, ShadingPoint, mis_weight, sample_emitter, spawn};
 use crate::bsdf::Measure;
@@ -21,11 +20,11 @@ pub struct PathMis {
 
 /// Russian roulette: returns false to terminate, else rescales `throughput`.
 #[inline]
-fn roulette(ctx: &mut Ctx, depth: u32, throughput: &mut Vec3, eta_scale: f32) -> bool {
+fn roulette(ctx: &mut Ctx, depth: u32, throughput: &mut Vec3) -> bool {
     if depth < RR_DEPTH {
         return true;
     }
-    let q = (throughput.max_element() * eta_scale).min(0.95);
+    let q = throughput.max_element().min(0.95);
     if q <= 0.0 || ctx.sampler.next_1d() >= q {
         return false;
     }
@@ -37,7 +36,6 @@ impl Integrator for PathMats {
     fn li(&self, scene: &RenderScene, ctx: &mut Ctx, mut o: Vec3, mut d: Vec3) -> Vec3 {
         let mut l = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
-        let mut eta_scale = 1.0;
         let mut depth = 1;
         loop {
             let Some(its) = scene.intersect(ctx, o, d) else {
@@ -49,15 +47,14 @@ impl Integrator for PathMats {
             if let Some((_, le, _)) = scene.emitted(&its, d, o) {
                 l += throughput * le;
             }
-            if depth >= self.max_depth || !roulette(ctx, depth, &mut throughput, eta_scale) {
+            if depth >= self.max_depth || !roulette(ctx, depth, &mut throughput) {
                 return l;
             }
             let sp = ShadingPoint::new(scene, ctx, &its, d);
-            let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
+            let Some((wo, w, _)) = sp.sample(ctx, &its, d) else {
                 return l;
             };
             throughput *= w;
-            eta_scale *= rec.eta * rec.eta;
             o = spawn(&its, wo);
             d = wo;
             depth += 1;
@@ -69,7 +66,6 @@ impl Integrator for PathMis {
     fn li(&self, scene: &RenderScene, ctx: &mut Ctx, mut o: Vec3, mut d: Vec3) -> Vec3 {
         let mut l = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
-        let mut eta_scale = 1.0;
         let mut depth = 1;
         // Density of the BSDF sample that produced the current ray; infinite for camera rays
         // and delta samples (emitter sampling could not have produced them: MIS weight 1).
@@ -91,7 +87,7 @@ impl Integrator for PathMis {
             let Some(its) = hit else {
                 return l;
             };
-            if depth >= self.max_depth || !roulette(ctx, depth, &mut throughput, eta_scale) {
+            if depth >= self.max_depth || !roulette(ctx, depth, &mut throughput) {
                 return l;
             }
             let sp = ShadingPoint::new(scene, ctx, &its, d);
@@ -107,7 +103,6 @@ impl Integrator for PathMis {
                 rec.pdf
             };
             throughput *= w;
-            eta_scale *= rec.eta * rec.eta;
             o = spawn(&its, wo);
             d = wo;
             depth += 1;
