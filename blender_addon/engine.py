@@ -163,6 +163,10 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
 
     # -- helpers --------------------------------------------------------------
 
+    def should_stop(self):
+        """Esc pressed (or Blender quitting). One place, so tests can simulate it."""
+        return self.test_break()
+
     def _fail(self, message):
         message = "Tesela: " + message
         print(message)
@@ -202,12 +206,12 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
         t0 = time.monotonic()
         try:
             res = export.write_gltf(depsgraph, gltf, width=width, height=height, camera=camera,
-                                    render_settings=render_settings, check_cancel=self.test_break)
+                                    render_settings=render_settings, check_cancel=self.should_stop)
         except export.ExportCancelled:
             return
         for w in res.warnings[:20]:
             print("Tesela: " + w)
-        if self.test_break():
+        if self.should_stop():
             return
         t_export = time.monotonic() - t0
 
@@ -215,21 +219,28 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
         if binary is None:
             self._fail(preferences.not_found_message(tried))
             return
+        result = self.begin_result(0, 0, rw, rh)
+        target = compat.combined_pass(result)
+        if (result.resolution_x, result.resolution_y) != (rw, rh) and region is not None:
+            # Blender rounded the border differently: follow the result it allocated,
+            # keeping the border's lower-left corner.
+            ymin = height - region[1] - region[3]
+            rw, rh = result.resolution_x, result.resolution_y
+            region = (region[0], height - ymin - rh, rw, rh)
+        if len(target.rect) != rw * rh:
+            self._fail("render result is %d pixels (%dx%d), expected %dx%d" % (
+                len(target.rect), result.resolution_x, result.resolution_y, rw, rh))
+            self.end_result(result)
+            return
+        # Full-frame mirror of the result, rows bottom to top (Blender's order).
+        mirror = np.zeros((rh, rw, 4), dtype=np.float32)
+
         args = renderer_args(binary, gltf, settings, width, height, region)
         try:
             session.start(args)
         except OSError as exc:
-            self._fail("cannot start the renderer %s: %s" % (binary, exc))
-            return
-
-        result = self.begin_result(0, 0, rw, rh)
-        # Full-frame mirror of the result, rows bottom to top (Blender's order).
-        mirror = np.zeros((rh, rw, 4), dtype=np.float32)
-        target = compat.combined_pass(result)
-        if len(target.rect) != rw * rh:
-            # Blender sized the result differently (should not happen): follow it.
-            self._fail("render result is %d pixels, expected %dx%d" % (len(target.rect), rw, rh))
             self.end_result(result)
+            self._fail("cannot start the renderer %s: %s" % (binary, exc))
             return
 
         hello = None
@@ -250,7 +261,7 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
 
         finished = False
         while not finished:
-            if self.test_break():
+            if self.should_stop():
                 cancelled = True
                 break
             try:
