@@ -19,7 +19,7 @@ Public API (all lengths in metres, angles in radians, colours linear RGB):
 * ``configure_cycles(scene, width, height, spp, max_bounces, seed)``: unbiased, comparable settings.
 * ``render_cycles(path)``, ``export_gltf(path)``: render the current scene to an EXR / write glTF.
 * ready scenes: ``cornell_box(spheres=False)``, ``light_over_plane(kind)``, ``emissive_sphere()``,
-  each returning a ``SceneInfo`` (the scene and a few facts the tests need).
+  ``glass_slab(color)``, each returning a ``SceneInfo`` (the scene and a few facts the tests need).
 
 Blender version differences live in ``_principled_socket`` (socket names), ``_use_nodes`` and
 ``_set_if`` (settings that only some versions have).
@@ -329,7 +329,9 @@ def render_cycles(path):
 
 def export_gltf(path):
     """Write the current scene with Blender's glTF exporter: default settings, plus cameras and
-    lights (so punctual lights use the default 'SPEC' photometric units)."""
+    lights (so punctual lights use the default 'SPEC' photometric units). The camera's ``yfov``
+    and ``aspectRatio`` follow the scene's resolution *at export time*: set it first (e.g. with
+    ``configure_cycles``)."""
     path = str(path)
     fmt = "GLB" if path.lower().endswith(".glb") else "GLTF_SEPARATE"
     bpy.ops.export_scene.gltf(filepath=path, export_format=fmt, export_cameras=True,
@@ -356,20 +358,26 @@ CORNELL_GREEN = (0.14, 0.45, 0.091)
 
 def cornell_box(spheres=False, light_strength=12.0):
     """A 2 m Lambertian Cornell box (x, y in [-1, 1], z in [0, 2], open towards -y) lit by a
-    0.7 m two-sided emissive quad just under the ceiling. ``spheres`` adds a mirror sphere and a
+    0.7 m two-sided emissive quad filling a hole in the ceiling. ``spheres`` adds a mirror sphere and a
     glass sphere (IOR 1.5), radius 0.4, on the floor. Camera at (0, -3.8, 1), 38° field of view."""
     scene = clear_scene()
     white = lambert("White", CORNELL_WHITE)
     red = lambert("Red", CORNELL_RED)
     green = lambert("Green", CORNELL_GREEN)
     add_quad("Floor", [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], white)
-    add_quad("Ceiling", [(-1, -1, 2), (-1, 1, 2), (1, 1, 2), (1, -1, 2)], white)
+    h = 0.35
+    # The ceiling has a square hole that the light fills, flush: a light hanging under a closed
+    # ceiling would light it from a few millimetres through its back face (emission is
+    # two-sided), a near-singular configuration that makes emitter sampling very noisy.
+    ceiling = [[(-1, -1), (-1, 1), (-h, 1), (-h, -1)], [(h, -1), (h, 1), (1, 1), (1, -1)],
+               [(-h, -1), (-h, -h), (h, -h), (h, -1)], [(-h, h), (-h, 1), (h, 1), (h, h)]]
+    for i, quad in enumerate(ceiling):
+        add_quad(f"Ceiling{i}", [(x, y, 2.0) for x, y in quad], white)
     add_quad("Back", [(-1, 1, 0), (1, 1, 0), (1, 1, 2), (-1, 1, 2)], white)
     add_quad("Left", [(-1, -1, 0), (-1, 1, 0), (-1, 1, 2), (-1, -1, 2)], red)
     add_quad("Right", [(1, -1, 0), (1, -1, 2), (1, 1, 2), (1, 1, 0)], green)
-    h = 0.35
     light = emitter("Light", (1.0, 1.0, 1.0), light_strength)
-    add_quad("LightQuad", [(-h, -h, 1.98), (-h, h, 1.98), (h, h, 1.98), (h, -h, 1.98)], light)
+    add_quad("LightQuad", [(-h, -h, 2.0), (-h, h, 2.0), (h, h, 2.0), (h, -h, 2.0)], light)
     if spheres:
         add_sphere("MirrorSphere", (-0.45, 0.35, 0.4), 0.4, mirror("Mirror"))
         add_sphere("GlassSphere", (0.45, -0.3, 0.4), 0.4, glass("Glass", 1.5))
@@ -415,3 +423,18 @@ def emissive_sphere(strength=4.0, color=(1.0, 0.6, 0.3)):
     add_sphere("Sphere", (0.0, 0.0, 0.8), 0.5, emitter("Glow", color, strength))
     add_camera((0.0, -4.0, 2.5), (0.0, 0.0, 0.5), fov=math.radians(45.0))
     return SceneInfo(scene, "emissive_sphere", {"radiance": [c * strength for c in color]})
+
+
+def glass_slab(color=(0.5, 0.5, 0.5), ior=1.5):
+    """A closed glass slab (4 x 4 x 0.2 m, base colour ``color``) 1 m above a two-sided emitter of
+    radiance 1, seen straight down through the slab by an orthographic camera 1 m across. Cycles
+    transmits ``color * (1 - F) / (1 + F)`` (F = 0.04 for IOR 1.5): 0.461 for colour 0.5, since
+    it tints each refraction by sqrt(colour)."""
+    scene = clear_scene()
+    add_quad("Glow", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
+             emitter("Glow", (1.0, 1.0, 1.0), 1.0))
+    add_box("Slab", (-2, -2, 1.0), (2, 2, 1.2), glass("Glass", ior, color))
+    add_camera((0.0, 0.0, 5.0), (0.0, 0.0, 0.0), ortho_scale=1.0)
+    f = ((ior - 1) / (ior + 1)) ** 2
+    return SceneInfo(scene, "glass_slab",
+                     {"transmitted": [c * (1 - f) / (1 + f) for c in color]})
