@@ -1,0 +1,186 @@
+"""The add-on in a real Blender executable (Debian's Blender 3.4 by default; TESELA_BLENDER
+overrides): `blender -b scene.blend -E TESELA -f 1`, an animation, and the real F12 path in the
+GUI under xvfb-run (render() in Blender's job thread).
+
+The add-on is installed into a private user scripts folder (BLENDER_USER_SCRIPTS/addons/tesela)
+and enabled with --addons. Each Blender runs with a private TMPDIR so that leftovers are visible.
+"""
+
+import json
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import imgcompare
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent.parent
+FAKE = HERE / "fake_renderer.py"
+BLENDER = os.environ.get("TESELA_BLENDER") or shutil.which("blender")
+XVFB = shutil.which("xvfb-run")
+
+pytestmark = pytest.mark.skipif(BLENDER is None, reason="no 'blender' executable (Debian package 'blender')")
+
+
+def fake_pattern(width, height):
+    xs = (np.arange(width) + 0.5) / width
+    ys = (np.arange(height) + 0.5) / height
+    img = np.empty((height, width, 4), dtype=np.float32)
+    img[..., 0] = xs[None, :]
+    img[..., 1] = ys[:, None]
+    img[..., 2] = 0.25
+    img[..., 3] = 1.0
+    return img
+
+
+@pytest.fixture(scope="module")
+def env34(tmp_path_factory):
+    base = tmp_path_factory.mktemp("blender34 ünï")
+    scripts = base / "user scripts"
+    shutil.copytree(REPO / "blender_addon", scripts / "addons" / "tesela",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    env = dict(os.environ)
+    env["BLENDER_USER_SCRIPTS"] = str(scripts)
+    env.pop("TESELA_BIN", None)
+    return base, env
+
+
+def run(cmd, env, timeout=180):
+    p = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout)
+    return p
+
+
+def make_scene(base, env, name, kind="simple", w=48, h=32, spp=4):
+    path = base / name
+    p = run([BLENDER, "-b", "--factory-startup", "--addons", "tesela", "--python",
+             str(HERE / "blender34_make_scene.py"), "--", str(path), kind, str(w), str(h), str(spp)], env)
+    assert "TESELA_SCENE_SAVED" in p.stdout, p.stdout[-3000:] + p.stderr[-3000:]
+    return path
+
+
+def private_tmp(base, name):
+    d = base / name
+    d.mkdir()
+    return d
+
+
+def leftovers(tmpdir):
+    return [n for n in os.listdir(tmpdir) if n.startswith("tesela")]
+
+
+def render_b(base, env, blend, binary, tag, extra=()):
+    tmp = private_tmp(base, "tmp " + tag)
+    env = dict(env, TMPDIR=str(tmp), TESELA_BINARY=str(binary))
+    out = base / ("out %s ###" % tag)
+    p = run([BLENDER, "-b", str(blend), "--addons", "tesela", "-E", "TESELA", "-o", str(out),
+             "-F", "OPEN_EXR"] + list(extra), env)
+    return p, tmp, out
+
+
+def test_background_render_fake(env34):
+    base, env = env34
+    blend = make_scene(base, env, "scène simple.blend")
+    p, tmp, out = render_b(base, env, blend, FAKE, "fake", ["-f", "1"])
+    exr = Path(str(out).replace("###", "001") + ".exr")
+    assert exr.is_file(), p.stdout[-3000:] + p.stderr[-3000:]
+    assert "Tesela | Sample" in p.stdout
+    img = imgcompare.read_exr(exr)
+    assert np.array_equal(img, fake_pattern(48, 32))
+    assert leftovers(tmp) == []
+
+
+def test_background_renderer_error(env34):
+    base, env = env34
+    blend = make_scene(base, env, "err.blend", w=32, h=32)
+    env = dict(env, FAKE_TESELA_MODE="error")
+    p, tmp, out = render_b(base, env, blend, FAKE, "error", ["-f", "1"])
+    assert "out of memory while building the BVH" in p.stdout + p.stderr
+    assert leftovers(tmp) == []
+
+
+def test_background_animation_no_leaks(env34):
+    """`-a` over 4 frames: one renderer per frame, none left, no file descriptors leaked."""
+    base, env = env34
+    blend = make_scene(base, env, "anim.blend", w=16, h=16)
+    fdlog = base / "fds.txt"
+    log = base / "anim-runs.jsonl"
+    hook = base / "fdhook.py"
+    hook.write_text(
+        "import bpy, os\n"
+        "def post(*_):\n"
+        "    with open(%r, 'a') as f:\n"
+        "        f.write('%%d\\n' %% len(os.listdir('/proc/self/fd')))\n"
+        "bpy.app.handlers.render_post.append(post)\n" % str(fdlog))
+    env = dict(env, FAKE_TESELA_LOG=str(log))
+    tmp = private_tmp(base, "tmp anim")
+    env = dict(env, TMPDIR=str(tmp), TESELA_BINARY=str(FAKE))
+    out = base / "anim_###"
+    p = run([BLENDER, "-b", str(blend), "--addons", "tesela", "--python", str(hook), "-E", "TESELA",
+             "-o", str(out), "-F", "OPEN_EXR", "-s", "1", "-e", "4", "-a"], env)
+    frames = sorted(base.glob("anim_*.exr"))
+    assert len(frames) == 4, p.stdout[-3000:] + p.stderr[-2000:]
+    fds = [int(v) for v in fdlog.read_text().split()]
+    assert len(fds) == 4 and len(set(fds)) == 1, fds
+    runs = [json.loads(line) for line in log.read_text().splitlines()]
+    assert len(runs) == 4 and len({r["pid"] for r in runs}) == 4
+    for r in runs:
+        assert not Path("/proc/%d" % r["pid"]).exists()
+    assert leftovers(tmp) == []
+
+
+def f12(base, env, blend, binary, tag, extra_env=None, timeout=120):
+    if XVFB is None:
+        pytest.skip("xvfb-run not installed")
+    tmp = private_tmp(base, "tmp f12 " + tag)
+    out = base / ("f12 %s.exr" % tag)
+    status = base / ("f12 %s.json" % tag)
+    env = dict(env, TESELA_BINARY=str(binary), **(extra_env or {}))
+    # TMPDIR only for Blender: xvfb-run keeps its X authority file in TMPDIR and cannot
+    # cope with the spaces in ours.
+    p = run([XVFB, "-a", "-s", "-screen 0 1280x1024x24", "env", "TMPDIR=" + str(tmp),
+             BLENDER, "--addons", "tesela", str(blend),
+             "--python", str(HERE / "blender34_f12.py"), "--", str(out), str(status), str(timeout)],
+            env, timeout=timeout + 60)
+    assert status.is_file(), p.stdout[-3000:] + p.stderr[-3000:]
+    st = json.loads(status.read_text())
+    return st, out, tmp, p
+
+
+def test_f12_gui_fake(env34):
+    base, env = env34
+    blend = make_scene(base, env, "f12 fake.blend", w=40, h=24)
+    st, out, tmp, p = f12(base, env, blend, FAKE, "fake")
+    assert st["error"] is None and st["complete"], st
+    assert st["render_pre_thread_is_main"] is False  # render() ran in the job thread
+    assert np.array_equal(imgcompare.read_exr(out), fake_pattern(40, 24))
+    assert leftovers(tmp) == []
+
+
+def test_f12_gui_renderer_error_does_not_hang(env34):
+    base, env = env34
+    blend = make_scene(base, env, "f12 err.blend", w=32, h=32)
+    st, out, tmp, p = f12(base, env, blend, FAKE, "die", {"FAKE_TESELA_MODE": "die"})
+    assert st["error"] is None, st
+    assert "SIGKILL" in p.stdout + p.stderr
+    assert leftovers(tmp) == []
+
+
+def test_f12_gui_real_renderer_equals_background(env34, tesela_bin):
+    """Real renderer: the F12 (job thread) image equals the `blender -b -f 1` image, bit for bit."""
+    base, env = env34
+    blend = make_scene(base, env, "cornell real.blend", kind="cornell", w=48, h=48, spp=8)
+    st, out, tmp, p = f12(base, env, blend, tesela_bin, "real", timeout=300)
+    assert st["error"] is None and st["complete"], (st, p.stdout[-2000:])
+    f12_img = imgcompare.read_exr(out)
+    assert leftovers(tmp) == []
+    pb, tmpb, outb = render_b(base, env, blend, tesela_bin, "real", ["-f", "1"])
+    exr = Path(str(outb).replace("###", "001") + ".exr")
+    assert exr.is_file(), pb.stdout[-3000:] + pb.stderr[-3000:]
+    bg_img = imgcompare.read_exr(exr)
+    assert np.isfinite(bg_img).all() and bg_img[..., :3].mean() > 0.01
+    assert np.array_equal(f12_img, bg_img)
+    assert leftovers(tmpb) == []
