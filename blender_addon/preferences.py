@@ -72,7 +72,7 @@ def find_renderer(context=None):
     for label, path in candidates(context):
         tried.append(path)
         if _is_exe(path):
-            return path, tried
+            return os.path.abspath(path), tried  # the renderer runs in the temp dir
         if label in ("TESELA_BINARY", "TESELA_BIN", "preferences"):
             return None, tried
     return None, tried

@@ -5,7 +5,7 @@ alone (it does not import the add-on), with fault modes for the tests.
 
 Environment:
   FAKE_TESELA_MODE   ok (default) | garbage | version | truncated | die | flood |
-                     silent | error | loaderror | slow
+                     silent | error | loaderror | slow | bench
   FAKE_TESELA_LOG    append one JSON line per run: pid, argv, scene facts
   FAKE_TESELA_TILE   tile edge in pixels (default 16)
   FAKE_TESELA_DELAY  seconds to sleep after each tile (default 0; 'slow' uses 0.05)
@@ -139,6 +139,22 @@ def main():
 
     delay = float(os.environ.get("FAKE_TESELA_DELAY", "0.05" if mode == "slow" else "0"))
     t0 = time.time()
+    if mode == "bench":
+        # As fast as possible: each tile is filled with one value (its index), so the
+        # cost measured on the reading side is the pipe's, not this script's.
+        import array
+        cache = {}
+        for i, (tx, ty, tw, th) in enumerate(tiles):
+            if STOP.is_set():
+                cancelled(out)
+            if (tw, th) not in cache:
+                cache[(tw, th)] = array.array("f", [0.5]) * (tw * th * 4)
+            px = cache[(tw, th)]
+            out.write(frame(2, struct.pack("<IIII", tx, ty, tw, th) + px.tobytes()))
+            out.write(frame(3, struct.pack("<IIId", i + 1, len(tiles), spp, time.time() - t0)))
+        out.write(frame(6, json.dumps({"seconds": time.time() - t0}).encode()))
+        out.flush()
+        return 0
     for i, (tx, ty, tw, th) in enumerate(tiles):
         if STOP.is_set():
             cancelled(out)
