@@ -64,6 +64,19 @@ def specular_to_factor(node, value):
     return max(0.0, min(1.0, 2.0 * float(value)))
 
 
+# --- node trees ----------------------------------------------------------------
+
+def node_tree(idblock):
+    """The material's/world's shader node tree if it renders with nodes, else None.
+    (5.0 deprecated use_nodes: every material and world uses nodes there.)"""
+    tree = getattr(idblock, "node_tree", None)
+    if tree is None:
+        return None
+    if VERSION < (5, 0, 0) and not idblock.use_nodes:
+        return None
+    return tree
+
+
 # --- mesh data ---------------------------------------------------------------
 
 def corner_normals(mesh, n_loops):

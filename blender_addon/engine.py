@@ -58,6 +58,53 @@ class StderrTail:
         return "\n".join(lines[-max_lines:])
 
 
+TMP_PREFIX = "tesela-render-"
+
+
+def make_tmpdir():
+    """A fresh private folder for one render, named after this Blender's pid so that a later
+    render can remove what a killed Blender left behind."""
+    return tempfile.mkdtemp(prefix="%s%d-" % (TMP_PREFIX, os.getpid()))
+
+
+def _pid_alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    try:  # a zombie (dead, not yet reaped) counts as dead
+        with open("/proc/%d/stat" % pid) as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except (OSError, IndexError):
+        return True
+
+
+def sweep_stale_tmpdirs():
+    """Remove render folders of Blender processes that no longer exist (killed mid-render)."""
+    base = tempfile.gettempdir()
+    try:
+        names = os.listdir(base)
+    except OSError:
+        return
+    me = os.getpid()
+    uid = os.getuid() if hasattr(os, "getuid") else None
+    for name in names:
+        if not name.startswith(TMP_PREFIX):
+            continue
+        pid = name[len(TMP_PREFIX):].split("-", 1)[0]
+        if not pid.isdigit() or int(pid) == me or _pid_alive(int(pid)):
+            continue
+        path = os.path.join(base, name)
+        try:
+            if uid is not None and os.stat(path).st_uid != uid:
+                continue
+        except OSError:
+            continue
+        shutil.rmtree(path, ignore_errors=True)
+
+
 def _describe_exit(code):
     if code is None:
         return "still running"
@@ -194,7 +241,8 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
 
     def _render(self, depsgraph, scene, settings, width, height, region, rw, rh, session):
         self.update_stats("", "Tesela | Exporting scene")
-        session.tmpdir = tempfile.mkdtemp(prefix="tesela-render-")
+        sweep_stale_tmpdirs()
+        session.tmpdir = make_tmpdir()
         gltf = os.path.join(session.tmpdir, "scene.gltf")
         camera = getattr(self, "camera_override", None) or scene.camera
         if camera is None:

@@ -109,7 +109,7 @@ def _input_value(sock, default):
 
 
 def _surface_node(material):
-    tree = material.node_tree if material.use_nodes else None
+    tree = compat.node_tree(material)
     if tree is None:
         return None
     outputs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
@@ -309,7 +309,7 @@ def convert_world(world, warnings):
     if world is None:
         return {"color": [0.0, 0.0, 0.0], "strength": 1.0}
     color, strength = list(world.color)[:3], 1.0
-    tree = world.node_tree if getattr(world, "use_nodes", False) else None
+    tree = compat.node_tree(world)
     if tree is not None:
         out = None
         for n in tree.nodes:
@@ -357,25 +357,25 @@ def _mesh_arrays(mesh):
     normals = compat.corner_normals(mesh, n_loops)
     uvs = compat.corner_uvs(mesh, n_loops)
 
-    # One glTF vertex per used corner.
-    used = np.unique(tri)
-    remap = np.full(n_loops, -1, dtype=np.int64)
-    remap[used] = np.arange(used.size)
-    positions = co[loop_vert[used]]
-    nrm = normals[used].astype(np.float32)
-    length = np.sqrt((nrm.astype(np.float64) ** 2).sum(axis=1))
-    bad = ~(length > 1e-12) | ~np.isfinite(length)
-    length[bad] = 1.0
-    nrm = (nrm / length[:, None]).astype(np.float32)
-    nrm[bad] = (0.0, 0.0, 1.0)
+    # One glTF vertex per corner (face corner = Blender loop): loop triangles cover every
+    # loop of every polygon, so the loop indices are the glTF indices as they are.
+    positions = co[loop_vert]
+    nrm = normals
+    sq = np.einsum("ij,ij->i", nrm, nrm)
+    if not (np.abs(sq - 1.0) < 1e-4).all():  # rare: renormalise, repair zero/NaN normals
+        length = np.sqrt(sq.astype(np.float64))
+        bad = ~(length > 1e-12)
+        length[bad] = 1.0
+        nrm = (nrm / length[:, None]).astype(np.float32)
+        nrm[bad] = (0.0, 0.0, 1.0)
     uv = None
     if uvs is not None:
-        uv = uvs[used].copy()
+        uv = uvs
         uv[:, 1] = 1.0 - uv[:, 1]  # glTF's UV origin is the top-left corner
-    indices = remap[tri].astype(np.uint32)
+    indices = tri.view(np.uint32)
     if not np.isfinite(positions).all():
         positions = np.nan_to_num(positions, nan=0.0, posinf=0.0, neginf=0.0)
-    return positions.astype(np.float32), nrm, uv, indices.reshape(-1, 3), tri_mat
+    return positions, nrm, uv, indices.reshape(-1, 3), tri_mat
 
 
 def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settings=None,
@@ -457,8 +457,9 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                                 attrs["TEXCOORD_0"] = buf.add(uv, FLOAT, "VEC2", ARRAY_BUFFER)
                             tri_mat = np.clip(tri_mat, 0, len(mats) - 1)
                             prims = []
-                            for mi in np.unique(tri_mat):
-                                sel = indices[tri_mat == mi]
+                            single = tri_mat.min() == tri_mat.max()
+                            for mi in ([tri_mat[0]] if single else np.unique(tri_mat)):
+                                sel = indices if single else indices[tri_mat == mi]
                                 acc = buf.add(sel.reshape(-1), UINT, "SCALAR", ELEMENT_ARRAY_BUFFER, True)
                                 prims.append({"attributes": attrs, "indices": acc, "mode": 4,
                                               "material": mat_idx(mats[int(mi)])})

@@ -73,6 +73,11 @@ def fake(monkeypatch, tmp_path):
     return runs
 
 
+def use_nodes(idblock):
+    if bpy.app.version < (5, 0, 0):  # 5.0 deprecated use_nodes (always on)
+        idblock.use_nodes = True
+
+
 def simple_scene(width=40, height=30, percentage=100, camera=True):
     """A plane, a cube with a material, a point light, an area light, a camera."""
     scene = bpy.context.scene
@@ -99,7 +104,7 @@ def simple_scene(width=40, height=30, percentage=100, camera=True):
                           [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (1, 3, 7, 5), (3, 2, 6, 7),
                            (2, 0, 4, 6)])
     mat = bpy.data.materials.get("TestRed") or bpy.data.materials.new("TestRed")
-    mat.use_nodes = True
+    use_nodes(mat)
     bsdf = next(n for n in mat.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
     bsdf.inputs["Base Color"].default_value = (0.8, 0.1, 0.1, 1.0)
     cube_mesh.materials.append(mat)
@@ -478,7 +483,7 @@ def _export(path, **kw):
 def test_export_contents(addon, tmp_path):
     scene = simple_scene(width=40, height=20)
     glow = bpy.data.materials.new("Glow")
-    glow.use_nodes = True
+    use_nodes(glow)
     nt = glow.node_tree
     nt.nodes.clear()
     em = nt.nodes.new("ShaderNodeEmission")
@@ -489,7 +494,7 @@ def test_export_contents(addon, tmp_path):
     scene.objects["Plane"].data.materials.append(glow)
     world = scene.world or bpy.data.worlds.new("W")
     scene.world = world
-    world.use_nodes = True
+    use_nodes(world)
     bg = world.node_tree.nodes["Background"]
     bg.inputs["Color"].default_value = (0.1, 0.2, 0.3, 1)
     bg.inputs["Strength"].default_value = 2.0
@@ -619,7 +624,7 @@ def test_export_passes_khronos_validator(addon, tmp_path):
     bm.free()
     mesh.polygons.foreach_set("use_smooth", [True] * len(mesh.polygons))
     glass = bpy.data.materials.new("Glass")
-    glass.use_nodes = True
+    use_nodes(glass)
     nt = glass.node_tree
     nt.nodes.clear()
     g = nt.nodes.new("ShaderNodeBsdfGlass")
@@ -705,3 +710,78 @@ def test_real_renderer_cancel(addon, tesela_bin, private_tmp, monkeypatch):
     assert end - record["first_true"] < 0.5
     assert child_renderers() == []
     assert os.listdir(private_tmp) == []
+
+
+# --------------------------------------------------------------------------------------------
+# leaks and speed
+
+def _fds():
+    return len(os.listdir("/proc/self/fd"))
+
+
+def test_repeated_renders_leak_no_fds_threads_or_processes(addon, fake, private_tmp, monkeypatch):
+    import threading
+    simple_scene(width=16, height=16)
+    render()  # warm up (Blender allocates its own things on the first render)
+    fds, threads = _fds(), threading.active_count()
+    for mode in ["ok", "error", "die", "garbage", "ok", "flood", "ok"]:
+        monkeypatch.setenv("FAKE_TESELA_MODE", mode)
+        try:
+            render()
+        except RuntimeError:
+            pass
+    assert _fds() == fds
+    assert threading.active_count() == threads
+    assert child_renderers() == []
+    assert os.listdir(private_tmp) == []
+
+
+def test_stale_temp_dirs_of_dead_blenders_are_swept(addon, fake, private_tmp):
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    stale = private_tmp / ("tesela-render-%d-abc" % dead.pid)
+    stale.mkdir()
+    (stale / "scene.gltf").write_text("{}")
+    alive = private_tmp / ("tesela-render-%d-xyz" % os.getppid())  # a live process: kept
+    alive.mkdir()
+    simple_scene(width=8, height=8)
+    render()
+    assert sorted(os.listdir(private_tmp)) == [alive.name]
+    alive.rmdir()
+
+
+def test_export_million_triangles_quickly(addon, tmp_path):
+    """The writer reads meshes with foreach_get into numpy: ~1M triangles in about a second."""
+    scene = simple_scene()
+    mesh = bpy.data.meshes.new("Grid")
+    n = 708  # (n-1)^2 * 2 ~= 1.0M triangles
+    xs = np.linspace(-1, 1, n, dtype=np.float32)
+    gx, gy = np.meshgrid(xs, xs)
+    co = np.stack([gx.ravel(), gy.ravel(), np.zeros(n * n, np.float32)], axis=1)
+    i = np.arange(n - 1)
+    a = (i[:, None] * n + i[None, :]).ravel()
+    quads = np.stack([a, a + 1, a + n + 1, a + n], axis=1)
+    mesh.vertices.add(n * n)
+    mesh.vertices.foreach_set("co", co.ravel())
+    mesh.loops.add(quads.size)
+    mesh.loops.foreach_set("vertex_index", quads.ravel().astype(np.int32))
+    mesh.polygons.add(len(quads))
+    mesh.polygons.foreach_set("loop_start", (np.arange(len(quads)) * 4).astype(np.int32))
+    if hasattr(mesh.polygons[0], "loop_total") and bpy.app.version < (4, 0, 0):
+        mesh.polygons.foreach_set("loop_total", np.full(len(quads), 4, np.int32))
+    mesh.update()
+    mesh.uv_layers.new(name="UV")
+    ob = bpy.data.objects.new("Grid", mesh)
+    scene.collection.objects.link(ob)
+    try:
+        t0 = time.perf_counter()
+        doc = _export(tmp_path / "big.gltf")
+        elapsed = time.perf_counter() - t0
+        tri = sum(doc["accessors"][p["indices"]]["count"] // 3
+                  for m in doc["meshes"] if m["name"] == "Grid" for p in m["primitives"])
+        print("exported %d triangles in %.2f s" % (tri, elapsed))
+        assert tri == 2 * (n - 1) ** 2
+        assert elapsed < 4.0, "export of %d triangles took %.2f s" % (tri, elapsed)
+    finally:
+        bpy.data.objects.remove(ob)
+        bpy.data.meshes.remove(mesh)

@@ -184,3 +184,50 @@ def test_f12_gui_real_renderer_equals_background(env34, tesela_bin):
     assert np.isfinite(bg_img).all() and bg_img[..., :3].mean() > 0.01
     assert np.array_equal(f12_img, bg_img)
     assert leftovers(tmpb) == []
+
+
+def _zombie_or_gone(pid):
+    try:
+        with open("/proc/%d/stat" % pid) as f:
+            return f.read().rsplit(")", 1)[1].split()[0] == "Z"
+    except OSError:
+        return True
+
+
+def test_blender_killed_mid_render(env34, tmp_path):
+    """SIGKILL Blender while it renders: the renderer sees stdin EOF and exits; the temp folder
+    Blender could not remove is swept by the next render (in another Blender)."""
+    import signal
+    import time
+    base, env = env34
+    blend = make_scene(base, env, "killed.blend", w=64, h=64)
+    log = base / "killed-runs.jsonl"
+    tmp = private_tmp(base, "tmp killed")
+    env = dict(env, TMPDIR=str(tmp), TESELA_BINARY=str(FAKE), FAKE_TESELA_LOG=str(log),
+               FAKE_TESELA_MODE="slow", FAKE_TESELA_DELAY="0.2")
+    p = subprocess.Popen([BLENDER, "-b", str(blend), "--addons", "tesela", "-E", "TESELA",
+                          "-o", str(base / "killed_###"), "-f", "1"], env=env,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 60
+        while not log.exists() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert log.exists(), "the renderer never started"
+        time.sleep(0.5)
+        renderer = json.loads(log.read_text().splitlines()[0])["pid"]
+        assert not _zombie_or_gone(renderer)
+        assert leftovers(tmp) != []
+    finally:
+        p.send_signal(signal.SIGKILL)
+        p.wait()
+    deadline = time.monotonic() + 2.0
+    while not _zombie_or_gone(renderer) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert _zombie_or_gone(renderer), "renderer survived its Blender"
+    assert len(leftovers(tmp)) == 1
+    env.pop("FAKE_TESELA_MODE")
+    env.pop("FAKE_TESELA_DELAY")
+    r = run([BLENDER, "-b", str(blend), "--addons", "tesela", "-E", "TESELA",
+             "-o", str(base / "after_###"), "-f", "1"], env)
+    assert "Tesela | Sample" in r.stdout
+    assert leftovers(tmp) == []
