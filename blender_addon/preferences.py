@@ -71,6 +71,12 @@ def find_renderer(context=None):
     tried = []
     for label, path in candidates(context):
         tried.append(path)
+        if label == "bundled" and os.path.isfile(path) and not os.access(path, os.X_OK):
+            # Blender's extension installer unpacks zips without the executable bit.
+            try:
+                os.chmod(path, os.stat(path).st_mode | 0o755)
+            except OSError:
+                pass
         if _is_exe(path):
             return os.path.abspath(path), tried  # the renderer runs in the temp dir
         if label in ("TESELA_BINARY", "TESELA_BIN", "preferences"):
