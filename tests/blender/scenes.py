@@ -428,8 +428,8 @@ def emissive_sphere(strength=4.0, color=(1.0, 0.6, 0.3)):
 def glass_slab(color=(0.5, 0.5, 0.5), ior=1.5):
     """A closed glass slab (4 x 4 x 0.2 m, base colour ``color``) 1 m above a two-sided emitter of
     radiance 1, seen straight down through the slab by an orthographic camera 1 m across. Cycles
-    transmits ``color * (1 - F) / (1 + F)`` (F = 0.04 for IOR 1.5): 0.461 for colour 0.5, since
-    it tints each refraction by sqrt(colour)."""
+    4.0+ transmits ``color * (1 - F) / (1 + F)`` (F = 0.04 for IOR 1.5): 0.461 for colour 0.5, since
+    it tints each refraction by sqrt(colour) (Cycles 3.x: by the colour, 0.230)."""
     scene = clear_scene()
     add_quad("Glow", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
              emitter("Glow", (1.0, 1.0, 1.0), 1.0))
