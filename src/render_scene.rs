@@ -192,6 +192,23 @@ impl RenderScene {
         })
     }
 
+    /// Like [`RenderScene::intersect`] for the ray leaving path vertex `depth - 1`; camera rays
+    /// (`depth == 1`) pass through meshes hidden from the camera.
+    #[inline]
+    pub fn trace(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, depth: u32) -> Option<Intersection> {
+        let mut its = self.intersect(ctx, o, d)?;
+        if depth != 1 {
+            return Some(its);
+        }
+        for _ in 0..64 {
+            if !self.scene.meshes[its.mesh as usize].hidden_from_camera {
+                return Some(its);
+            }
+            its = self.intersect(ctx, offset_origin(its.p, its.ng, d), d)?;
+        }
+        Some(its)
+    }
+
     /// True when nothing blocks the segment from surface point `p` (geometric normal `ng`)
     /// to the emitter sample `rec` (a point, or a direction at infinity).
     #[inline]

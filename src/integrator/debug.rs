@@ -11,7 +11,7 @@ pub struct Albedo;
 
 impl Integrator for Normals {
     fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
-        match scene.intersect(ctx, o, d) {
+        match scene.trace(ctx, o, d, 1) {
             Some(its) => its.ns * 0.5 + Vec3::splat(0.5),
             None => Vec3::ZERO,
         }
@@ -20,7 +20,7 @@ impl Integrator for Normals {
 
 impl Integrator for Albedo {
     fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
-        match scene.intersect(ctx, o, d) {
+        match scene.trace(ctx, o, d, 1) {
             Some(its) => scene.surface_params(&its).base_color,
             None => Vec3::ZERO,
         }

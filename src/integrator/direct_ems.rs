@@ -16,7 +16,7 @@ impl Integrator for DirectEms {
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
         loop {
-            let Some(its) = scene.intersect(ctx, o, d) else {
+            let Some(its) = scene.trace(ctx, o, d, depth) else {
                 if let Some((_, le, _)) = scene.background_radiance(d, o) {
                     l += throughput * le;
                 }

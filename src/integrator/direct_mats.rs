@@ -16,7 +16,7 @@ impl Integrator for DirectMats {
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
         loop {
-            let Some(its) = scene.intersect(ctx, o, d) else {
+            let Some(its) = scene.trace(ctx, o, d, depth) else {
                 if let Some((_, le, _)) = scene.background_radiance(d, o) {
                     l += throughput * le;
                 }
@@ -38,7 +38,7 @@ impl Integrator for DirectMats {
             depth += 1;
             if rec.measure != Measure::Discrete {
                 // The one non-delta bounce: count what it sees, then stop.
-                match scene.intersect(ctx, o, d) {
+                match scene.trace(ctx, o, d, depth) {
                     Some(next) => {
                         if let Some((_, le, _)) = scene.emitted(&next, d, o) {
                             l += throughput * le;

@@ -18,7 +18,7 @@ impl Integrator for DirectMis {
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
         loop {
-            let Some(its) = scene.intersect(ctx, o, d) else {
+            let Some(its) = scene.trace(ctx, o, d, depth) else {
                 if let Some((_, le, _)) = scene.background_radiance(d, o) {
                     l += throughput * le;
                 }
@@ -43,7 +43,7 @@ impl Integrator for DirectMis {
             depth += 1;
             if rec.measure != Measure::Discrete {
                 // The BSDF half of MIS at this vertex, then stop.
-                let hit = match scene.intersect(ctx, o, d) {
+                let hit = match scene.trace(ctx, o, d, depth) {
                     Some(next) => scene.emitted(&next, d, o),
                     None => scene.background_radiance(d, o),
                 };

@@ -38,7 +38,7 @@ impl Integrator for PathMats {
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
         loop {
-            let Some(its) = scene.intersect(ctx, o, d) else {
+            let Some(its) = scene.trace(ctx, o, d, depth) else {
                 if let Some((_, le, _)) = scene.background_radiance(d, o) {
                     l += throughput * le;
                 }
@@ -71,7 +71,7 @@ impl Integrator for PathMis {
         // and delta samples (emitter sampling could not have produced them: MIS weight 1).
         let mut bsdf_pdf = f32::INFINITY;
         loop {
-            let hit = scene.intersect(ctx, o, d);
+            let hit = scene.trace(ctx, o, d, depth);
             let emitted = match &hit {
                 Some(its) => scene.emitted(its, d, o),
                 None => scene.background_radiance(d, o),

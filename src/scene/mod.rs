@@ -29,6 +29,9 @@ pub struct Mesh {
     pub indices: Vec<[u32; 3]>,
     /// Index into [`Scene::materials`].
     pub material: usize,
+    /// Camera rays pass through this mesh (a Blender light with camera visibility off);
+    /// every other ray sees it.
+    pub hidden_from_camera: bool,
 }
 
 /// How a texture is sampled at a texel boundary.

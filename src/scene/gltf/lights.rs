@@ -259,6 +259,9 @@ impl<'a> Loader<'a> {
                     uvs: Vec::new(),
                     indices,
                     material,
+                    hidden_from_camera: !member(t, "visible_camera")
+                        .and_then(Value::as_bool)
+                        .unwrap_or(true),
                 });
             }
             other => {

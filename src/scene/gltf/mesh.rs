@@ -150,6 +150,7 @@ impl<'a> Loader<'a> {
                 uvs,
                 indices,
                 material,
+                hidden_from_camera: false,
             });
         }
         Ok(())
