@@ -312,6 +312,7 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
                 self.update_result(result)
             push_cost[0] = time.monotonic() - t
 
+        end_deadline = None
         finished = False
         while not finished:
             if self.should_stop():
@@ -320,6 +321,9 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
             try:
                 msg = session.messages.get(timeout=POLL_SECONDS)
             except queue.Empty:
+                # After DONE or ERROR the renderer must exit; don't wait forever for it.
+                if (done is not None or error is not None) and time.monotonic() > end_deadline:
+                    break
                 continue
             batch = [msg]
             while len(batch) < 4096:
@@ -362,9 +366,11 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
                     if msg.level >= 2:
                         self.report({"WARNING"}, "Tesela: " + msg.message)
                 elif isinstance(msg, protocol.Error):
+                    end_deadline = time.monotonic() + 2.0
                     error = msg.message
                     error_from_renderer = True  # then Eof follows as the renderer exits
                 elif isinstance(msg, protocol.Done):
+                    end_deadline = time.monotonic() + 2.0
                     done = msg.stats
                 elif isinstance(msg, protocol.Failure):
                     error = msg.message
@@ -381,12 +387,13 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
                 dirty = False
                 last_push = now
 
+        if cancelled:
+            # Stop the renderer first (the 0.5 s budget), then keep the partial image.
+            session.close()
         if dirty:
             push(final=True)
         self.end_result(result)
-
         if cancelled:
-            session.close()
             self.update_stats("", "Tesela | Cancelled")
             return
         # Normal end or failure: let a finishing renderer exit by itself briefly.

@@ -5,7 +5,7 @@ alone (it does not import the add-on), with fault modes for the tests.
 
 Environment:
   FAKE_TESELA_MODE   ok (default) | garbage | version | truncated | die | flood |
-                     silent | error | loaderror | slow | bench
+                     silent | error | errorhang | loaderror | slow | bench
   FAKE_TESELA_LOG    append one JSON line per run: pid, argv, scene facts
   FAKE_TESELA_TILE   tile edge in pixels (default 16)
   FAKE_TESELA_DELAY  seconds to sleep after each tile (default 0; 'slow' uses 0.05)
@@ -127,6 +127,13 @@ def main():
              for y in range(0, rh, tile) for x in range(0, rw, tile)]
     out.write(frame(1, b"TSLA" + struct.pack("<IIIII", version, rw, rh, spp, len(tiles))))
     out.flush()
+    if mode == "errorhang":
+        # Reports an error, then neither exits nor honours stdin EOF or SIGTERM.
+        out.write(frame(5, b"device lost (fake), and now I hang"))
+        out.flush()
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        while True:
+            time.sleep(1)
     if mode == "version":
         time.sleep(0.2)
         sys.exit(0)

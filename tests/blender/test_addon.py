@@ -333,6 +333,7 @@ FAULTS = [
     ("truncated", "truncated TILE frame", True),
     ("garbage", "not a Tesela renderer (bad magic)", False),
     ("version", "protocol version mismatch: renderer speaks 7, add-on speaks 1", False),
+    ("errorhang", "device lost (fake)", False),
 ]
 
 
@@ -577,10 +578,16 @@ def test_export_instances_and_modifiers(addon, tmp_path):
 def _validator():
     node = shutil.which("node")
     npm = shutil.which("npm")
-    if node is None or npm is None:
-        pytest.skip("node/npm not available for the Khronos glTF validator")
-    cache = Path(os.environ.get("TESELA_NPM_CACHE", Path(tempfile.gettempdir()) / "tesela-gltf-validator"))
+    if node is None:
+        pytest.skip("node not available for the Khronos glTF validator")
+    # scripts/test.sh installs it into .venv/node; otherwise npm installs it into a cache.
+    cache = REPO / ".venv" / "node"
     if not (cache / "node_modules" / "gltf-validator").is_dir():
+        cache = Path(os.environ.get("TESELA_NPM_CACHE",
+                                    Path(tempfile.gettempdir()) / "tesela-gltf-validator"))
+    if not (cache / "node_modules" / "gltf-validator").is_dir():
+        if npm is None:
+            pytest.skip("npm not available to install the Khronos glTF validator")
         cache.mkdir(parents=True, exist_ok=True)
         r = subprocess.run([npm, "install", "--prefix", str(cache), "gltf-validator"],
                            capture_output=True, text=True, timeout=300)
@@ -643,7 +650,8 @@ def test_export_passes_khronos_validator(addon, tmp_path):
     _export(dest / "scene.gltf")
     report = validate(dest / "scene.gltf")
     issues = report["issues"]
-    assert issues["numErrors"] == 0, json.dumps(issues["messages"], indent=1)[:3000]
+    assert issues["numErrors"] == 0 and issues["numWarnings"] == 0, \
+        json.dumps(issues["messages"], indent=1)[:3000]
     assert report["info"]["totalTriangleCount"] > 100
 
 
