@@ -136,6 +136,24 @@ def combined_pass(result):
     return p
 
 
+# --- lights --------------------------------------------------------------------
+
+def light_color_and_scale(light):
+    """(linear colour, power multiplier) with the settings later Blenders added:
+    blackbody temperature (4.x), exposure (power * 2^exposure, 4.x)."""
+    color = list(light.color)[:3]
+    if getattr(light, "use_temperature", False):
+        tc = getattr(light, "temperature_color", None)
+        if tc is not None:
+            color = [c * t for c, t in zip(color, tc)]
+    return color, 2.0 ** float(getattr(light, "exposure", 0.0))
+
+
+def light_normalized(light):
+    """4.x 'Normalize': when off, Cycles does not divide the power by the emitting area."""
+    return bool(getattr(light, "normalize", True))
+
+
 # --- object visibility ---------------------------------------------------------
 
 def visible_camera(obj):

@@ -220,23 +220,44 @@ def convert_material(material, warnings):
 
 # --- lights ----------------------------------------------------------------------
 
-def convert_light(light, obj):
+def convert_light(light, obj, matrix=None, warnings=None):
     t = light.type
-    ext = {"type": t, "color": _color3(light.color)}
+    color, scale = compat.light_color_and_scale(light)
+    ext = {"type": t, "color": _color3(color)}
+    energy = _finite(light.energy) * scale
     if t == "SUN":
-        ext["strength"] = _finite(light.energy)
+        ext["strength"] = energy
         ext["angle"] = _finite(getattr(light, "angle", 0.0))
     else:
-        ext["power"] = _finite(light.energy)
+        ext["power"] = energy
     if t in ("POINT", "SPOT"):
         ext["radius"] = _finite(getattr(light, "shadow_soft_size", 0.0))
     if t == "SPOT":
         ext["spot_size"] = _finite(light.spot_size)
         ext["spot_blend"] = _finite(light.spot_blend)
+        if getattr(light, "use_square", False) and warnings is not None:
+            warnings.append("light '%s': square spots render as round ones" % obj.name)
     if t == "AREA":
         ext["shape"] = light.shape
         ext["size"] = _finite(light.size)
         ext["size_y"] = _finite(light.size_y) if light.shape in ("RECTANGLE", "ELLIPSE") else _finite(light.size)
+        spread = getattr(light, "spread", math.pi)
+        if spread < math.pi - 1e-4 and warnings is not None:
+            warnings.append("light '%s': area light spread is ignored" % obj.name)
+    if not compat.light_normalized(light) and t != "SUN":
+        # Cycles then keeps the radiance of a 1 m^2 (or 1 m radius disc) emitter:
+        # the same picture as a normalized light of power * area.
+        sx = sy = 1.0
+        if matrix is not None:
+            sx = float(np.linalg.norm(matrix[:3, 0]))
+            sy = float(np.linalg.norm(matrix[:3, 1]))
+        if t == "AREA":
+            area = ext["size"] * sx * ext["size_y"] * sy
+            if light.shape in ("DISK", "ELLIPSE"):
+                area *= math.pi / 4.0
+            ext["power"] *= area
+        elif ext.get("radius", 0.0) > 0.0:
+            ext["power"] *= math.pi * ext["radius"] ** 2
     ext["visible_camera"] = compat.visible_camera(obj)
 
     # A KHR_lights_punctual copy for other tools (Blender exporter's 'SPEC' units).
@@ -476,7 +497,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             res.triangles += ntri
             add_node({"name": obj.name, "mesh": mi, "matrix": _gltf_matrix(_matrix(inst.matrix_world))})
         elif otype == "LIGHT":
-            ext, khr = convert_light(obj.data, obj)
+            ext, khr = convert_light(obj.data, obj, _matrix(inst.matrix_world), warnings)
             node = {"name": obj.name, "matrix": _gltf_matrix(_matrix(inst.matrix_world)),
                     "extensions": {"TESELA_light": ext}}
             used_ext.add("TESELA_light")

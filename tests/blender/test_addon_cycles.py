@@ -74,6 +74,33 @@ def world_colour():
     return info
 
 
+def _needs(datablock, attr):
+    if not hasattr(datablock, attr):
+        pytest.skip("Blender %s lights have no '%s'" % (bpy.app.version_string, attr))
+
+
+def area_unnormalized():
+    """4.x 'Normalize' off: Cycles keeps the radiance of a 1 m^2 light of that power."""
+    info = area_over_plane()
+    light = bpy.data.lights["Area"]
+    _needs(light, "normalize")
+    light.normalize = False
+    ob = bpy.data.objects["Area"]
+    ob.scale = (1.5, 0.5, 1.0)  # the object's scale changes the area too
+    return info
+
+
+def point_exposure_temperature():
+    """4.x exposure (power * 2^exposure) and blackbody colour."""
+    info = scenes.light_over_plane("point")
+    light = bpy.data.lights["Point"]
+    _needs(light, "exposure")
+    light.exposure = 1.5
+    light.use_temperature = True
+    light.temperature = 3500.0
+    return info
+
+
 # (id, builder, Cycles max_bounces, Tesela integrator, spp)
 CASES = [
     ("cornell-direct_mis", lambda: scenes.cornell_box(), 0, "direct_mis", 256),
@@ -88,6 +115,8 @@ CASES = [
     ("area_square-direct_mis", area_over_plane, 0, "direct_mis", 256),
     ("area_rectangle-direct_mis", rect_area_over_plane, 0, "direct_mis", 256),
     ("area_disk-direct_mis", disk_area_over_plane, 0, "direct_mis", 256),
+    ("area_unnormalized_scaled-direct_mis", area_unnormalized, 0, "direct_mis", 256),
+    ("point_exposure_temperature-direct_mis", point_exposure_temperature, 0, "direct_mis", 64),
     ("world-path_mis", world_colour, 4, "path_mis", 512),
     ("emissive_sphere-direct_mis", lambda: scenes.emissive_sphere(), 0, "direct_mis", 256),
 ]
