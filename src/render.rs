@@ -5,7 +5,7 @@
 use crate::camera::RayCamera;
 use crate::integrator::{self, Integrator};
 use crate::render_scene::{Ctx, RenderScene};
-use crate::sampler::Sampler;
+use crate::sampler::SobolSampler;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
@@ -148,7 +148,7 @@ fn render_pixel(
     let mut accepted = 0u32;
     for s in 0..opts.spp {
         let mut ctx = Ctx {
-            sampler: Sampler::new(opts.seed, pixel_index, s as u64),
+            sampler: SobolSampler::new(opts.seed, pixel_index, s as u64),
             rays: 0,
         };
         let film = Vec2::new(px as f32, py as f32) + ctx.sampler.next_2d();

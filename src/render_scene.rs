@@ -38,7 +38,7 @@ impl Intersection {
 
 /// Per-path-sample state: the random stream and counters.
 pub struct Ctx {
-    pub sampler: crate::sampler::Sampler,
+    pub sampler: crate::sampler::SobolSampler,
     /// Rays traced (camera, bounce and shadow rays).
     pub rays: u64,
 }
