@@ -793,3 +793,41 @@ def test_export_million_triangles_quickly(addon, tmp_path):
     finally:
         bpy.data.objects.remove(ob)
         bpy.data.meshes.remove(mesh)
+
+
+def test_real_renderer_error_reaches_blender(addon, tesela_bin, tmp_path, monkeypatch, private_tmp):
+    """The real renderer refuses a broken scene: its message is what Blender reports."""
+    wrapper = tmp_path / "break-scene"
+    wrapper.write_text('#!/bin/sh\nprintf \'{"asset": {"version": "2.0"}, "nodes": [{"mesh": 7}]}\' > "$2"\n'
+                       'exec "%s" "$@"\n' % tesela_bin)
+    wrapper.chmod(0o755)
+    monkeypatch.setenv("TESELA_BINARY", str(wrapper))
+    simple_scene(width=16, height=16)
+    with pytest.raises(RuntimeError, match="Tesela: renderer error: ") as info:
+        render()
+    print(info.value)
+    assert child_renderers() == []
+    assert os.listdir(private_tmp) == []
+
+
+def test_real_renderer_killed_mid_frame(addon, tesela_bin, tmp_path, monkeypatch, private_tmp):
+    """SIGKILL the real renderer mid-render: a clear message, the tiles so far kept."""
+    wrapper = tmp_path / "kill-renderer"
+    wrapper.write_text(
+        "#!%s\nimport os, signal, subprocess, sys, time\n"
+        "p = subprocess.Popen([%r] + sys.argv[1:])\n"
+        "time.sleep(1.5)\n"
+        "p.kill(); p.wait()\n"
+        "os.kill(os.getpid(), signal.SIGKILL)\n" % (sys.executable, str(tesela_bin)))
+    wrapper.chmod(0o755)
+    monkeypatch.setenv("TESELA_BINARY", str(wrapper))
+    scene = simple_scene(width=200, height=150)
+    scene.tesela.samples = 512
+    with pytest.raises(RuntimeError, match="SIGKILL") as info:
+        render()
+    print(info.value)
+    assert "mid-render" in str(info.value) or "truncated" in str(info.value)
+    covered = result_pixels(tmp_path)[..., 3] > 0
+    assert 0 < covered.sum() < covered.size, "expected a partial image"
+    assert child_renderers() == []
+    assert os.listdir(private_tmp) == []
