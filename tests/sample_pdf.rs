@@ -1,0 +1,578 @@
+//! Consistency of every sampling routine with its own density and value: the pdf that `sample`
+//! reports equals `pdf()` on the sampled direction (relative 1e-3), and the returned weight is
+//! `eval · |cos| / pdf` for BSDFs and `eval / pdf` for emitters. Delta BSDFs and lights have
+//! `pdf() = 0` and `eval() = 0`. Plus the fallbacks of mesh emitters: no vertex normals, and
+//! one-sided emission.
+
+use glam::{Vec2, Vec3};
+use tesela::bsdf::{
+    Bsdf, BsdfQueryRecord, Dielectric, Diffuse, Measure, Mirror, Plastic, RoughConductor,
+    SurfaceParams, choose,
+};
+use tesela::emitter::{
+    AreaEmitter, Directional, Emitter, EmitterInstance, EmitterQueryRecord, LightChoice,
+    PointLight, SpotLight,
+};
+use tesela::render_scene::RenderScene;
+use tesela::sampler::Sampler;
+use tesela::sampling::square_to_uniform_sphere;
+use tesela::scene::builtin::{quad, sphere};
+use tesela::scene::{Light, Material, Mesh, Scene, SpotFalloff};
+
+const REL: f32 = 1e-3;
+
+fn close(a: f32, b: f32, rel: f32) -> bool {
+    (a - b).abs() <= rel * a.abs().max(b.abs()) + 1e-12
+}
+
+fn close3(a: Vec3, b: Vec3, rel: f32) -> bool {
+    (a - b).abs().max_element() <= rel * a.abs().max(b.abs()).max_element() + 1e-12
+}
+
+/// Random incident directions over the whole sphere, with extra grazing and normal ones.
+fn incident(rng: &mut Sampler, k: usize) -> Vec3 {
+    match k % 8 {
+        0 => {
+            let w = square_to_uniform_sphere(rng.next_2d());
+            Vec3::new(w.x, w.y, 0.002 * w.z.signum()).normalize()
+        }
+        1 => Vec3::new(1e-4, -2e-4, 1.0).normalize(),
+        _ => square_to_uniform_sphere(rng.next_2d()),
+    }
+}
+
+/// Samples `bsdf` many times and checks each sample against `pdf()` and `eval()`.
+/// Returns the number of non-delta samples checked.
+fn check_bsdf(name: &str, bsdf: &dyn Bsdf, seed: u64) -> usize {
+    let mut rng = Sampler::new(seed, 0, 0);
+    let mut checked = 0;
+    for k in 0..20_000 {
+        let wi = incident(&mut rng, k);
+        let mut rec = BsdfQueryRecord::new(wi);
+        let w = bsdf.sample(&mut rec, rng.next_2d(), rng.next_1d());
+        assert!(
+            w.is_finite() && w.min_element() >= 0.0,
+            "{name}: weight {w}"
+        );
+        if w == Vec3::ZERO {
+            continue;
+        }
+        // Every BSDF here reflects only on the +Z side.
+        assert!(
+            wi.z > 0.0 && rec.wo.z > 0.0,
+            "{name}: wi {wi} wo {}",
+            rec.wo
+        );
+        assert!(
+            (rec.wo.length() - 1.0).abs() < 1e-4,
+            "{name}: |wo| = {}",
+            rec.wo.length()
+        );
+        let pair = BsdfQueryRecord::pair(wi, rec.wo);
+        match rec.measure {
+            Measure::SolidAngle => {
+                let pdf = bsdf.pdf(&pair);
+                assert!(
+                    rec.pdf > 0.0 && rec.pdf.is_finite(),
+                    "{name}: rec.pdf {}",
+                    rec.pdf
+                );
+                assert!(
+                    close(rec.pdf, pdf, REL),
+                    "{name}: sample reports pdf {} but pdf() = {pdf} (wi {wi}, wo {})",
+                    rec.pdf,
+                    rec.wo
+                );
+                let want = bsdf.eval(&pair) * rec.wo.z.abs() / pdf;
+                assert!(
+                    close3(w, want, REL),
+                    "{name}: weight {w} but eval·cos/pdf = {want} (wi {wi}, wo {})",
+                    rec.wo
+                );
+                checked += 1;
+            }
+            Measure::Discrete => assert_eq!(rec.pdf, 0.0, "{name}: delta sample with a pdf"),
+        }
+    }
+    println!("{name}: {checked} samples checked");
+    checked
+}
+
+#[test]
+fn bsdf_sample_pdf_and_weight_agree() {
+    let c = Vec3::new(0.9, 0.5, 0.2);
+    let mut seed = 1;
+    let mut run = |name: String, b: &dyn Bsdf| {
+        seed += 1;
+        assert!(!b.is_delta(), "{name}");
+        assert!(
+            check_bsdf(&name, b, seed) > 1000,
+            "{name}: too few samples checked"
+        );
+    };
+    run("Diffuse".into(), &Diffuse::new(c));
+    for alpha in [0.0f32, 0.002, 0.02, 0.1, 0.4, 1.0] {
+        run(
+            format!("RoughConductor alpha={alpha}"),
+            &RoughConductor::new(c, alpha),
+        );
+    }
+    for (alpha, ior, spec, color) in [
+        (0.0f32, 1.5f32, 1.0f32, Vec3::ONE),
+        (0.0, 2.0, 0.5, Vec3::new(1.0, 0.4, 0.2)),
+        (0.01, 1.5, 1.0, Vec3::ONE),
+        (0.2, 1.45, 1.0, Vec3::ONE),
+        (0.6, 2.5, 0.3, Vec3::new(0.2, 0.9, 0.5)),
+        (1.0, 1.5, 1.0, Vec3::ONE),
+    ] {
+        run(
+            format!("Plastic alpha={alpha} ior={ior} specular={spec}"),
+            &Plastic::new(c, alpha, ior, spec, color),
+        );
+    }
+}
+
+#[test]
+fn chosen_bsdf_instances_agree() {
+    // The same checks through `choose` and the enum dispatch the integrators use.
+    let mut seed = 100;
+    for (metallic, roughness, transmission, specular) in [
+        (0.0f32, 0.5f32, 0.0f32, 1.0f32),
+        (0.0, 0.0, 0.0, 1.0),
+        (0.0, 0.7, 0.0, 0.0),
+        (1.0, 0.3, 0.0, 1.0),
+        (1.0, 0.9, 0.0, 1.0),
+    ] {
+        let p = SurfaceParams {
+            base_color: Vec3::new(0.8, 0.6, 0.4),
+            metallic,
+            roughness,
+            transmission,
+            ior: 1.5,
+            specular,
+            specular_color: Vec3::ONE,
+        };
+        let b = choose(&p, 0.5);
+        seed += 1;
+        check_bsdf(&format!("{b:?}"), &b, seed);
+    }
+}
+
+#[test]
+fn delta_bsdfs_have_no_density_and_no_value() {
+    let mut rng = Sampler::new(200, 0, 0);
+    let bsdfs: Vec<(&str, Box<dyn Bsdf>)> = vec![
+        ("Mirror", Box::new(Mirror::new(Vec3::new(0.9, 0.7, 0.5)))),
+        ("Dielectric 1.5", Box::new(Dielectric::new(1.5, Vec3::ONE))),
+        (
+            "Dielectric 0.7",
+            Box::new(Dielectric::new(0.7, Vec3::splat(0.5))),
+        ),
+    ];
+    for (name, b) in &bsdfs {
+        assert!(b.is_delta(), "{name}");
+        for k in 0..5000 {
+            let wi = incident(&mut rng, k);
+            let mut rec = BsdfQueryRecord::new(wi);
+            let w = b.sample(&mut rec, rng.next_2d(), rng.next_1d());
+            if w != Vec3::ZERO {
+                assert_eq!(rec.measure, Measure::Discrete, "{name}");
+                assert_eq!(rec.pdf, 0.0, "{name}");
+                let pair = BsdfQueryRecord::pair(wi, rec.wo);
+                assert_eq!(b.pdf(&pair), 0.0, "{name}: pdf on the sampled direction");
+                assert_eq!(
+                    b.eval(&pair),
+                    Vec3::ZERO,
+                    "{name}: eval on the sampled direction"
+                );
+            }
+            let other = BsdfQueryRecord::pair(wi, square_to_uniform_sphere(rng.next_2d()));
+            assert_eq!(b.pdf(&other), 0.0, "{name}");
+            assert_eq!(b.eval(&other), Vec3::ZERO, "{name}");
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Emitters.
+
+fn v(x: f32, y: f32, z: f32) -> Vec3 {
+    Vec3::new(x, y, z)
+}
+
+/// Triangles without vertex normals.
+fn bare_mesh(name: &str, material: usize, tris: &[[Vec3; 3]]) -> Mesh {
+    let mut m = Mesh {
+        name: name.into(),
+        material,
+        ..Default::default()
+    };
+    for t in tris {
+        let b = m.positions.len() as u32;
+        m.positions.extend(t);
+        m.indices.push([b, b + 1, b + 2]);
+    }
+    m
+}
+
+fn emitter_scene() -> Scene {
+    let mut s = Scene {
+        materials: vec![
+            Material::diffuse("floor", Vec3::splat(0.5)),
+            Material::emitter("one-sided", v(4.0, 3.0, 2.0), false),
+            Material::emitter("two-sided", v(1.0, 2.0, 3.0), true),
+        ],
+        background: v(0.1, 0.2, 0.3),
+        ..Default::default()
+    };
+    s.meshes.push(quad(
+        "floor",
+        0,
+        v(-3., 0., 3.),
+        v(3., 0., 3.),
+        v(3., 0., -3.),
+        v(-3., 0., -3.),
+    ));
+    // One-sided quad facing down, flat normals.
+    s.meshes.push(quad(
+        "ceiling light",
+        1,
+        v(-0.5, 2., -0.5),
+        v(0.5, 2., -0.5),
+        v(0.5, 2., 0.5),
+        v(-0.5, 2., 0.5),
+    ));
+    // Smooth-shaded sphere: shading normals differ from the facets' geometric normals.
+    s.meshes
+        .push(sphere("bulb", 2, v(1.5, 1.0, 0.0), 0.3, 6, 12));
+    s.meshes
+        .push(sphere("one-sided bulb", 1, v(-1.5, 1.0, 0.5), 0.25, 5, 10));
+    // Triangles without normals, tilted and of unequal size.
+    s.meshes.push(bare_mesh(
+        "bare",
+        1,
+        &[
+            [v(0., 0.5, -2.), v(1., 0.6, -2.), v(0.2, 1.5, -1.8)],
+            [v(-1., 0.5, -2.), v(-0.5, 0.5, -1.9), v(-0.9, 0.7, -2.)],
+        ],
+    ));
+    s.lights = vec![
+        Light::Directional {
+            direction: v(0.2, -1.0, 0.1),
+            irradiance: v(2., 2., 2.),
+            angle: 0.3,
+        },
+        Light::Directional {
+            direction: v(-0.3, -1.0, 0.4),
+            irradiance: v(1., 1., 1.),
+            angle: 3.0,
+        },
+        Light::Point {
+            position: v(0., 1.5, 0.),
+            intensity: v(5., 5., 5.),
+        },
+        Light::Spot {
+            position: v(1., 1.8, 1.),
+            direction: v(0., -1., 0.),
+            intensity: v(8., 6., 4.),
+            falloff: SpotFalloff::Gltf {
+                cos_inner: 0.95,
+                cos_outer: 0.8,
+            },
+        },
+        Light::Directional {
+            direction: v(0., -1., 0.),
+            irradiance: v(3., 3., 3.),
+            angle: 0.0,
+        },
+    ];
+    s
+}
+
+/// The record the integrators rebuild for MIS when a BSDF-sampled ray hits the emitter at the
+/// sampled point (or leaves the scene in the sampled direction).
+fn rebuilt(e: &EmitterInstance, rec: &EmitterQueryRecord) -> EmitterQueryRecord {
+    match e {
+        EmitterInstance::Area(_) => {
+            EmitterQueryRecord::between(rec.ref_p, rec.p, rec.n, rec.ng, rec.uv)
+        }
+        _ => EmitterQueryRecord::towards(rec.ref_p, rec.wi),
+    }
+}
+
+#[test]
+fn emitter_sample_pdf_and_weight_agree() {
+    let rs = RenderScene::new(emitter_scene(), LightChoice::Power);
+    let scene = &rs.scene;
+    assert_eq!(rs.emitters.len(), 4 + 5 + 1, "4 area, 5 lights, background");
+    let mut rng = Sampler::new(300, 0, 0);
+    for (i, e) in rs.emitters.iter().enumerate() {
+        let name = format!("emitter {i} ({})", kind(e));
+        let mut checked = 0;
+        let mut dark = 0;
+        for _ in 0..20_000 {
+            let ref_p = v(6.0, 5.0, 6.0) * (rng.next_2d().extend(rng.next_1d()) - 0.5) + Vec3::Y;
+            let mut rec = EmitterQueryRecord::from_ref(ref_p);
+            let w = e.sample(scene, &mut rec, rng.next_2d());
+            assert!(
+                w.is_finite() && w.min_element() >= 0.0,
+                "{name}: weight {w}"
+            );
+            if e.is_delta() {
+                assert_eq!(rec.pdf, 0.0, "{name}");
+                assert_eq!(e.pdf(scene, &rec), 0.0, "{name}");
+                assert_eq!(e.eval(scene, &rec), Vec3::ZERO, "{name}");
+                continue;
+            }
+            assert!(
+                (rec.wi.length() - 1.0).abs() < 1e-4,
+                "{name}: |wi| {}",
+                rec.wi.length()
+            );
+            if rec.pdf == 0.0 {
+                assert_eq!(w, Vec3::ZERO, "{name}: weight without a density");
+                continue;
+            }
+            let pdf = e.pdf(scene, &rec);
+            assert!(
+                close(rec.pdf, pdf, REL),
+                "{name}: sample reports pdf {} but pdf() = {pdf}",
+                rec.pdf
+            );
+            let again = rebuilt(e, &rec);
+            let pdf2 = e.pdf(scene, &again);
+            assert!(
+                close(pdf2, pdf, REL),
+                "{name}: rebuilt record's pdf {pdf2} vs {pdf}"
+            );
+            let le = e.eval(scene, &rec);
+            assert!(
+                close3(e.eval(scene, &again), le, REL),
+                "{name}: rebuilt eval"
+            );
+            assert!(
+                close3(w, le / pdf, REL),
+                "{name}: weight {w} but eval/pdf = {}",
+                le / pdf
+            );
+            if let EmitterInstance::Area(a) = e {
+                assert!((rec.dist - (rec.p - ref_p).length()).abs() < 1e-4 * rec.dist);
+                assert!(
+                    (rec.n.length() - 1.0).abs() < 1e-4 && (rec.ng.length() - 1.0).abs() < 1e-4
+                );
+                assert!(
+                    rec.n.dot(rec.ng) >= 0.0,
+                    "{name}: ng on the other side of n"
+                );
+                // The area density converted to solid angle, independently.
+                let cos = rec.ng.dot(rec.wi).abs();
+                let want = rec.dist * rec.dist / (cos * a.area);
+                assert!(
+                    close(pdf, want, REL),
+                    "{name}: pdf {pdf} vs d²/(cos A) = {want}"
+                );
+            } else {
+                assert!(rec.dist.is_infinite(), "{name}");
+            }
+            if le == Vec3::ZERO {
+                dark += 1;
+            }
+            checked += 1;
+        }
+        println!("{name}: {checked} samples checked, {dark} of them from behind a one-sided face");
+        if !e.is_delta() {
+            assert!(checked > 10_000, "{name}");
+        }
+    }
+}
+
+fn kind(e: &EmitterInstance) -> &'static str {
+    match e {
+        EmitterInstance::Area(_) => "area",
+        EmitterInstance::Point(_) => "point",
+        EmitterInstance::Spot(_) => "spot",
+        EmitterInstance::Directional(_) => "directional",
+        EmitterInstance::Background(_) => "background",
+    }
+}
+
+#[test]
+fn light_choice_is_folded_into_the_reported_pdf() {
+    for choice in [LightChoice::Power, LightChoice::Uniform] {
+        let rs = RenderScene::new(emitter_scene(), choice);
+        let mut rng = Sampler::new(400, 0, 0);
+        for _ in 0..20_000 {
+            let ref_p = v(4.0, 2.0, 4.0) * (rng.next_2d().extend(rng.next_1d()) - 0.5);
+            let (i, rec, w) = rs.sample_light(ref_p, rng.next_1d(), rng.next_2d());
+            let e = &rs.emitters[i as usize];
+            let pmf = rs.lights.pmf(i as usize);
+            assert!(pmf > 0.0);
+            if rs.is_delta_light(i) {
+                assert_eq!(rec.pdf, 0.0);
+                assert_eq!(rs.light_pdf(i, &rec), 0.0);
+                continue;
+            }
+            if w == Vec3::ZERO {
+                continue;
+            }
+            let single = e.pdf(&rs.scene, &rec);
+            assert!(close(rec.pdf, pmf * single, REL), "pmf·pdf");
+            assert!(
+                close(rs.light_pdf(i, &rebuilt(e, &rec)), rec.pdf, REL),
+                "light_pdf"
+            );
+            let le = e.eval(&rs.scene, &rec);
+            assert!(
+                close3(w, le / rec.pdf, REL),
+                "weight {w} vs Le/(pmf·pdf) {}",
+                le / rec.pdf
+            );
+        }
+    }
+}
+
+#[test]
+fn delta_lights() {
+    let scene = Scene::default();
+    let point = PointLight {
+        position: v(1., 2., 3.),
+        intensity: v(4., 5., 6.),
+    };
+    let spot = SpotLight {
+        position: v(0., 3., 0.),
+        direction: v(0., -1., 0.),
+        intensity: v(10., 10., 10.),
+        falloff: SpotFalloff::Gltf {
+            cos_inner: 0.9,
+            cos_outer: 0.5,
+        },
+    };
+    let sun = Directional::new(v(0.3, -1., 0.), v(2., 2., 2.), 0.0);
+    let mut rng = Sampler::new(500, 0, 0);
+    for _ in 0..1000 {
+        let ref_p = v(2.0, 1.0, 2.0) * (rng.next_2d().extend(rng.next_1d()) - 0.5);
+        for (name, e) in [
+            ("point", &point as &dyn Emitter),
+            ("spot", &spot),
+            ("sun", &sun),
+        ] {
+            assert!(e.is_delta(), "{name}");
+            let mut rec = EmitterQueryRecord::from_ref(ref_p);
+            let w = e.sample(&scene, &mut rec, rng.next_2d());
+            assert_eq!(rec.pdf, 0.0, "{name}");
+            assert_eq!(e.pdf(&scene, &rec), 0.0, "{name}");
+            assert_eq!(e.eval(&scene, &rec), Vec3::ZERO, "{name}");
+            let d2 = (rec.p - ref_p).length_squared();
+            match name {
+                "point" => {
+                    assert!(close3(w, point.intensity / d2, 1e-5), "point: {w}");
+                    assert!(((point.position - ref_p).normalize() - rec.wi).length() < 1e-5);
+                    assert!((rec.dist * rec.dist - d2).abs() < 1e-4 * d2);
+                }
+                "spot" => {
+                    // Below the light and within the inner cone: full intensity.
+                    let cos = (ref_p - spot.position).normalize().dot(spot.direction);
+                    if cos >= 0.9 {
+                        assert!(close3(w, spot.intensity / d2, 1e-5), "spot: {w}");
+                    }
+                    assert_eq!(w == Vec3::ZERO, cos <= 0.5, "spot cutoff at cos {cos}");
+                }
+                _ => {
+                    assert_eq!(w, v(2., 2., 2.));
+                    assert!((rec.wi + v(0.3, -1., 0.).normalize()).length() < 1e-6);
+                    assert!(rec.dist.is_infinite());
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn mesh_emitter_without_normals_uses_the_geometric_normal() {
+    // Two triangles, counter-clockwise seen from +Y (front faces up), no normals or uvs.
+    let tris = [
+        [v(0., 0., 0.), v(0., 0., -1.), v(-1., 0., 0.)],
+        [v(2., 0.5, 0.), v(2., 0.5, -2.), v(0.5, 0.5, 0.)],
+    ];
+    let scene = Scene {
+        meshes: vec![bare_mesh("bare", 0, &tris)],
+        materials: vec![Material::emitter("e", v(1., 1., 1.), false)],
+        ..Default::default()
+    };
+    assert!(scene.meshes[0].normals.is_empty() && scene.meshes[0].uvs.is_empty());
+    let e = AreaEmitter::new(&scene, 0).expect("an emitter");
+    assert!(close(e.area, 0.5 + 1.5, 1e-6), "area {}", e.area);
+    let mut rng = Sampler::new(600, 0, 0);
+    let mut lit = [0usize; 2];
+    for k in 0..4000 {
+        // From above: lit; from below: dark (one-sided, front = +Y by the right-hand rule).
+        let above = k % 2 == 0;
+        let ref_p = v(0.5, if above { 3.0 } else { -3.0 }, -0.5);
+        let mut rec = EmitterQueryRecord::from_ref(ref_p);
+        let w = e.sample(&scene, &mut rec, rng.next_2d());
+        assert!(
+            (rec.n - Vec3::Y).length() < 1e-6,
+            "shading normal {}",
+            rec.n
+        );
+        assert!(
+            (rec.ng - Vec3::Y).length() < 1e-6,
+            "geometric normal {}",
+            rec.ng
+        );
+        assert!(
+            rec.p.y.abs() < 1e-6 || (rec.p.y - 0.5).abs() < 1e-6,
+            "point {}",
+            rec.p
+        );
+        assert!(rec.pdf > 0.0 && rec.pdf.is_finite());
+        assert_eq!(rec.uv, Vec2::ZERO);
+        if above {
+            assert!(close3(w, Vec3::ONE / rec.pdf, REL), "weight {w}");
+            lit[(rec.p.y > 0.25) as usize] += 1;
+        } else {
+            assert_eq!(w, Vec3::ZERO, "lit from behind");
+        }
+    }
+    // Both triangles are sampled, roughly 1 : 3 by area.
+    let frac = lit[1] as f64 / 2000.0;
+    assert!(
+        (frac - 0.75).abs() < 0.05,
+        "share of the large triangle {frac}"
+    );
+}
+
+#[test]
+fn one_sided_emitter_is_dark_from_behind() {
+    let rs = RenderScene::new(emitter_scene(), LightChoice::Power);
+    let scene = &rs.scene;
+    // Emitter 0 is the one-sided ceiling quad facing down (−Y), emitter 1 the two-sided bulb.
+    let EmitterInstance::Area(ceiling) = &rs.emitters[0] else {
+        panic!("emitter 0 is not the ceiling light")
+    };
+    let EmitterInstance::Area(bulb) = &rs.emitters[1] else {
+        panic!("emitter 1 is not the bulb")
+    };
+    assert!(!ceiling.two_sided && bulb.two_sided);
+    let mut rng = Sampler::new(700, 0, 0);
+    for _ in 0..2000 {
+        let (below, above) = (v(0.1, 1.0, 0.2), v(0.1, 3.0, 0.2));
+        let mut rec = EmitterQueryRecord::from_ref(below);
+        let w = ceiling.sample(scene, &mut rec, rng.next_2d());
+        assert!(w.max_element() > 0.0, "lit from the front");
+        let mut rec = EmitterQueryRecord::from_ref(above);
+        let w = ceiling.sample(scene, &mut rec, rng.next_2d());
+        assert!(rec.pdf > 0.0, "the point is still a valid sample");
+        assert_eq!(w, Vec3::ZERO, "one-sided emitter lit from behind");
+        assert_eq!(ceiling.eval(scene, &rec), Vec3::ZERO);
+        let back = EmitterQueryRecord::between(above, rec.p, rec.n, rec.ng, rec.uv);
+        assert_eq!(ceiling.eval(scene, &back), Vec3::ZERO);
+        // The two-sided bulb shines from inside-out facets seen from behind as well.
+        let mut rec = EmitterQueryRecord::from_ref(v(1.5, 1.0, 0.0) + v(0.0, 0.0, 2.0));
+        let w = bulb.sample(scene, &mut rec, rng.next_2d());
+        assert!(
+            w.max_element() > 0.0,
+            "two-sided emitter dark from one side"
+        );
+    }
+}
