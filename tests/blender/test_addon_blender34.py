@@ -231,3 +231,25 @@ def test_blender_killed_mid_render(env34, tmp_path):
              "-o", str(base / "after_###"), "-f", "1"], env)
     assert "Tesela | Sample" in r.stdout
     assert leftovers(tmp) == []
+
+
+def test_two_blenders_render_at_once(env34):
+    """Two Blender processes rendering at the same time, same TMPDIR: distinct scene folders,
+    both images right, nothing left behind."""
+    base, env = env34
+    blend = make_scene(base, env, "twice.blend", w=32, h=32)
+    log = base / "twice-runs.jsonl"
+    tmp = private_tmp(base, "tmp twice")
+    env = dict(env, TMPDIR=str(tmp), TESELA_BINARY=str(FAKE), FAKE_TESELA_LOG=str(log),
+               FAKE_TESELA_MODE="slow", FAKE_TESELA_DELAY="0.5")
+    procs = [subprocess.Popen([BLENDER, "-b", str(blend), "--addons", "tesela", "-E", "TESELA",
+                               "-o", str(base / ("twice%d_###" % i)), "-F", "OPEN_EXR", "-f", "1"],
+                              env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+             for i in range(2)]
+    outs = [p.communicate(timeout=120)[0] for p in procs]
+    runs = [json.loads(line) for line in log.read_text().splitlines()]
+    assert len(runs) == 2 and runs[0]["scene_dir"] != runs[1]["scene_dir"], outs
+    for i in range(2):
+        img = imgcompare.read_exr(base / ("twice%d_001.exr" % i))
+        assert np.array_equal(img, fake_pattern(32, 32))
+    assert leftovers(tmp) == []
