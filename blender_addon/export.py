@@ -133,7 +133,105 @@ def _surface_node(material):
     return node
 
 
-def convert_material(material, warnings):
+def write_png(path, pixels):
+    """Write float RGBA (h, w, 4), rows top to bottom, values already encoded, as a 16-bit PNG."""
+    import struct
+    import zlib
+    h, w = pixels.shape[:2]
+    data = np.clip(np.nan_to_num(pixels, nan=0.0), 0.0, 1.0)
+    data = (data * 65535.0 + 0.5).astype(">u2").view(np.uint8).reshape(h, w * 8)
+    raw = np.zeros((h, w * 8 + 1), dtype=np.uint8)  # filter byte 0 per row
+    raw[:, 1:] = data
+
+    def chunk(tag, body):
+        return (struct.pack(">I", len(body)) + tag + body
+                + struct.pack(">I", zlib.crc32(tag + body) & 0xFFFFFFFF))
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n")
+        f.write(chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 16, 6, 0, 0, 0)))
+        f.write(chunk(b"IDAT", zlib.compress(raw.tobytes(), 6)))
+        f.write(chunk(b"IEND", b""))
+
+
+def _linear_to_srgb(c):
+    c = np.maximum(c, 0.0)
+    return np.where(c <= 0.0031308, c * 12.92, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
+
+
+class _Textures:
+    """Images, samplers and textures of one export; images are PNG files beside the .gltf."""
+
+    def __init__(self, folder, stem, warnings):
+        self.folder, self.stem, self.warnings = folder, stem, warnings
+        self.images, self.samplers, self.textures = [], [], []
+        self._image_index, self._sampler_index, self._texture_index = {}, {}, {}
+
+    def image_texture(self, sock, material_name):
+        """glTF texture index for an Image Texture node feeding `sock` directly, else None."""
+        if sock is None or not sock.is_linked:
+            return None
+        link = sock.links[0]
+        node = link.from_node
+        while node.bl_idname == "NodeReroute" and node.inputs[0].is_linked:
+            link = node.inputs[0].links[0]
+            node = link.from_node
+        if node.bl_idname != "ShaderNodeTexImage" or node.image is None:
+            return None
+        if link.from_socket.name != "Color":
+            return None
+        vec = node.inputs.get("Vector")
+        if vec is not None and vec.is_linked:
+            self.warnings.append("material '%s': texture coordinates of '%s' are linked; the active "
+                                 "UV map is used" % (material_name, node.name))
+        img = self._image(node.image)
+        if img is None:
+            return None
+        closest = getattr(node, "interpolation", "Linear") == "Closest"
+        filt = 9728 if closest else 9729  # NEAREST or LINEAR; no mipmaps, as Cycles
+        wrap = {"REPEAT": 10497, "EXTEND": 33071, "CLIP": 33071, "MIRROR": 33648}.get(
+            getattr(node, "extension", "REPEAT"), 10497)
+        if getattr(node, "extension", "") == "CLIP":
+            self.warnings.append("material '%s': texture clipping renders as 'Extend'" % material_name)
+        skey = (filt, wrap)
+        if skey not in self._sampler_index:
+            self.samplers.append({"magFilter": filt, "minFilter": filt, "wrapS": wrap, "wrapT": wrap})
+            self._sampler_index[skey] = len(self.samplers) - 1
+        tkey = (img, self._sampler_index[skey])
+        if tkey not in self._texture_index:
+            self.textures.append({"source": img, "sampler": self._sampler_index[skey]})
+            self._texture_index[tkey] = len(self.textures) - 1
+        return self._texture_index[tkey]
+
+    def _image(self, image):
+        key = image.name
+        if key in self._image_index:
+            return self._image_index[key]
+        self._image_index[key] = None
+        w, h = image.size[0], image.size[1]
+        if w == 0 or h == 0:
+            self.warnings.append("image '%s' has no pixels (missing file?); texture ignored" % image.name)
+            return None
+        channels = image.channels
+        buf = np.empty(w * h * channels, dtype=np.float32)
+        image.pixels.foreach_get(buf)
+        buf = buf.reshape(h, w, channels)[::-1]  # Blender's rows run bottom to top
+        rgba = np.ones((h, w, 4), dtype=np.float32)
+        rgba[..., :min(channels, 4)] = buf[..., :4]
+        if channels < 3:
+            rgba[..., 1] = rgba[..., 2] = rgba[..., 0]
+        cs = image.colorspace_settings.name
+        if image.is_float or cs not in ("sRGB",):
+            # Linear values (float buffers, non-sRGB colour spaces): glTF wants sRGB.
+            rgba[..., :3] = _linear_to_srgb(rgba[..., :3])
+        name = "%s_%d.png" % (self.stem, len(self.images))
+        write_png(os.path.join(self.folder, name), rgba)
+        from urllib.parse import quote
+        self.images.append({"uri": quote(name), "name": image.name, "mimeType": "image/png"})
+        self._image_index[key] = len(self.images) - 1
+        return self._image_index[key]
+
+
+def convert_material(material, warnings, textures=None):
     """A Blender material -> glTF material dict (plus extensions used)."""
     name = material.name
     base = list(material.diffuse_color)[:3]
@@ -145,11 +243,22 @@ def convert_material(material, warnings):
     specular = None
     emission = [0.0, 0.0, 0.0]
     strength = 0.0
+    base_tex = None
 
     node = _surface_node(material)
     if node is not None:
         kind = node.bl_idname
+        color_sock = None
+        if kind == "ShaderNodeBsdfPrincipled":
+            color_sock = compat.principled_input(node, "base_color")
+        elif kind in ("ShaderNodeBsdfDiffuse", "ShaderNodeBsdfGlossy", "ShaderNodeBsdfAnisotropic",
+                      "ShaderNodeBsdfGlass", "ShaderNodeBsdfRefraction"):
+            color_sock = node.inputs.get("Color")
+        if textures is not None and color_sock is not None:
+            base_tex = textures.image_texture(color_sock, name)
         for sock in node.inputs:
+            if sock == color_sock and base_tex is not None:
+                continue
             if sock.is_linked and sock.name not in ("Normal", "Tangent", "Clearcoat Normal",
                                                     "Coat Normal", "Weight"):
                 warnings.append("material '%s': input '%s' of %s is linked; its unlinked value is used"
@@ -194,6 +303,9 @@ def convert_material(material, warnings):
     pbr = {"baseColorFactor": base + [min(1.0, max(0.0, alpha))],
            "metallicFactor": min(1.0, max(0.0, metallic)),
            "roughnessFactor": min(1.0, max(0.0, roughness))}
+    if base_tex is not None:
+        pbr["baseColorFactor"] = [1.0, 1.0, 1.0, pbr["baseColorFactor"][3]]
+        pbr["baseColorTexture"] = {"index": base_tex}
     out = {"name": name, "pbrMetallicRoughness": pbr,
            "doubleSided": not getattr(material, "use_backface_culling", False)}
     ext = {}
@@ -419,6 +531,9 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     used_ext = set()
     root_nodes = doc["scenes"][0]["nodes"]
     material_index = {}
+    out_dir = os.path.dirname(os.path.abspath(filepath))
+    stem = os.path.splitext(os.path.basename(filepath))[0]
+    textures = _Textures(out_dir, stem, warnings)
     mesh_cache = {}
     khr_lights = []
 
@@ -429,7 +544,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
         if mat is None:
             m = dict(DEFAULT_MATERIAL)
         else:
-            m = convert_material(mat, warnings)
+            m = convert_material(mat, warnings, textures)
         for e in m.get("extensions", {}):
             used_ext.add(e)
         doc["materials"].append(m)
@@ -472,6 +587,12 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                         if arrays is not None:
                             mats = [s.material for s in obj.material_slots] or [None]
                             positions, nrm, uv, indices, tri_mat = arrays
+                            mat_ids = [mat_idx(m) for m in mats]
+                            if uv is None and any("baseColorTexture" in doc["materials"][i]["pbrMetallicRoughness"]
+                                                  for i in mat_ids):
+                                # No UV map: Cycles reads UV (0, 0) everywhere; so do we.
+                                uv = np.zeros((positions.shape[0], 2), dtype=np.float32)
+                                uv[:, 1] = 1.0
                             attrs = {"POSITION": buf.add(positions, FLOAT, "VEC3", ARRAY_BUFFER, True),
                                      "NORMAL": buf.add(nrm, FLOAT, "VEC3", ARRAY_BUFFER)}
                             if uv is not None:
@@ -483,7 +604,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                                 sel = indices if single else indices[tri_mat == mi]
                                 acc = buf.add(sel.reshape(-1), UINT, "SCALAR", ELEMENT_ARRAY_BUFFER, True)
                                 prims.append({"attributes": attrs, "indices": acc, "mode": 4,
-                                              "material": mat_idx(mats[int(mi)])})
+                                              "material": mat_ids[int(mi)]})
                             doc["meshes"].append({"name": obj.name, "primitives": prims})
                             mesh_cache[key] = (len(doc["meshes"]) - 1, int(indices.shape[0]))
                     finally:
@@ -524,6 +645,10 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
         ext_root["KHR_lights_punctual"] = {"lights": khr_lights}
     doc["extensions"] = ext_root
 
+    if textures.images:
+        doc["images"] = textures.images
+        doc["samplers"] = textures.samplers
+        doc["textures"] = textures.textures
     # Remove empty top-level arrays (glTF forbids empty arrays).
     for k in ("nodes", "meshes", "materials", "cameras"):
         if not doc[k]:

@@ -645,9 +645,23 @@ def test_export_passes_khronos_validator(addon, tmp_path):
     for kind in ("SPOT", "SUN"):
         ob = bpy.data.objects.new(kind, bpy.data.lights.new(kind, kind))
         scene.collection.objects.link(ob)
+    # an image texture (written as a PNG beside the .gltf)
+    img = bpy.data.images.new("Tex ü", 8, 4, alpha=True)
+    img.pixels.foreach_set(np.linspace(0, 1, 8 * 4 * 4, dtype=np.float32))
+    red = bpy.data.materials["TestRed"]
+    tex = red.node_tree.nodes.new("ShaderNodeTexImage")
+    tex.image = img
+    bsdf = next(n for n in red.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+    red.node_tree.links.new(tex.outputs["Color"], bsdf.inputs["Base Color"])
     dest = tmp_path / "valid dïr"
     dest.mkdir()
-    _export(dest / "scene.gltf")
+    doc = _export(dest / "scene.gltf")
+    red.node_tree.nodes.remove(tex)
+    assert len(doc["images"]) == 1 and doc["images"][0]["mimeType"] == "image/png"
+    mat = next(m for m in doc["materials"] if m["name"] == "TestRed")
+    assert mat["pbrMetallicRoughness"]["baseColorTexture"] == {"index": 0}
+    from urllib.parse import unquote
+    assert (dest / unquote(doc["images"][0]["uri"])).read_bytes()[:4] == b"\x89PNG"
     report = validate(dest / "scene.gltf")
     issues = report["issues"]
     assert issues["numErrors"] == 0 and issues["numWarnings"] == 0, \
