@@ -472,9 +472,13 @@ def convert_world(world, warnings):
 _MESHLIKE = {"MESH", "CURVE", "SURFACE", "FONT", "META", "CURVES_LEGACY"}
 
 
-def _mesh_arrays(mesh):
+def _mesh_arrays(mesh, check_cancel=None):
     """(positions, normals, uvs, tri_corners, tri_material) for an evaluated mesh."""
+    def checkpoint():
+        if check_cancel is not None and check_cancel():
+            raise ExportCancelled()
     mesh.calc_loop_triangles()
+    checkpoint()
     nt = len(mesh.loop_triangles)
     if nt == 0:
         return None
@@ -487,8 +491,11 @@ def _mesh_arrays(mesh):
     loop_vert = np.empty(n_loops, dtype=np.int32)
     mesh.loops.foreach_get("vertex_index", loop_vert)
     co = compat.vertex_positions(mesh, n_verts)
+    checkpoint()
     normals = compat.corner_normals(mesh, n_loops)
+    checkpoint()
     uvs = compat.corner_uvs(mesh, n_loops)
+    checkpoint()
 
     # One glTF vertex per corner (face corner = Blender loop): loop triangles cover every
     # loop of every polygon, so the loop indices are the glTF indices as they are.
@@ -575,6 +582,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             data = obj.data
             key = (obj.name, data.as_pointer() if data is not None else 0)
             if key not in mesh_cache:
+                if check_cancel is not None and check_cancel():
+                    raise ExportCancelled()
                 mesh_cache[key] = None
                 mesh = None
                 try:
@@ -583,7 +592,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                     mesh = None
                 if mesh is not None:
                     try:
-                        arrays = _mesh_arrays(mesh)
+                        arrays = _mesh_arrays(mesh, check_cancel)
                         if arrays is not None:
                             mats = [s.material for s in obj.material_slots] or [None]
                             positions, nrm, uv, indices, tri_mat = arrays
@@ -631,6 +640,14 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
 
     cam = camera if camera is not None else scene.camera
     if cam is not None and cam.type == "CAMERA":
+        cd = cam.data
+        if cd.type == "PANO":
+            warnings.append("camera '%s': panoramic cameras are not supported; rendering it as "
+                            "a perspective camera" % cam.name)
+        if abs(cd.shift_x) > 1e-6 or abs(cd.shift_y) > 1e-6:
+            warnings.append("camera '%s': lens shift is ignored" % cam.name)
+        if getattr(getattr(cd, "dof", None), "use_dof", False):
+            warnings.append("camera '%s': depth of field is ignored" % cam.name)
         doc["cameras"].append(dict(camera_fields(cam.data, width, height), name=cam.data.name))
         add_node({"name": cam.name, "camera": 0, "matrix": _gltf_matrix(_camera_matrix(cam))})
         res.has_camera = True
