@@ -237,8 +237,6 @@ class Mitsuba:
         mi.set_variant(self.variant)
         t0 = time.perf_counter()
         self.pixels = width * height
-        # LLVM renders a whole pass as one wavefront: keep it near 2^22 lanes (memory).
-        self.pass_spp = max(1, 2 ** int(math.log2(max(1, 2 ** 22 // self.pixels))))
         d = {"type": "scene"}
         c = scene.camera
         d["sensor"] = {
@@ -266,25 +264,16 @@ class Mitsuba:
         self.integrators.clear()
         return {"write_s": t1 - t0, "load_s": time.perf_counter() - t1}
 
-    def _integrator(self, mode, per_pass):
-        key = (mode, per_pass)
-        if key not in self.integrators:
-            d = dict(MODES[mode]["mitsuba"])
-            if per_pass:
-                d["samples_per_pass"] = per_pass
-            self.integrators[key] = self.mi.load_dict(d)
-        return self.integrators[key]
-
-    def round_spp(self, spp):
-        if self.variant.startswith("llvm") and spp > self.pass_spp:
-            return max(self.pass_spp, round(spp / self.pass_spp) * self.pass_spp)
-        return spp
+    def _integrator(self, mode):
+        # No samples_per_pass: Mitsuba 3.9 deprecates it and splits large wavefronts itself.
+        if mode not in self.integrators:
+            self.integrators[mode] = self.mi.load_dict(dict(MODES[mode]["mitsuba"]))
+        return self.integrators[mode]
 
     def render(self, mode, spp, seed):
         mi, dr = self.mi, self.dr
         mi.set_variant(self.variant)
-        per_pass = self.pass_spp if (self.variant.startswith("llvm") and spp > self.pass_spp) else 0
-        integ = self._integrator(mode, per_pass)
+        integ = self._integrator(mode)
         t0 = time.perf_counter()
         img = mi.render(self.scene, integrator=integ, spp=spp, seed=seed)
         dr.eval(img)
@@ -322,37 +311,38 @@ def bench_mode(peers, scene_name, mode, args, W, H):
         r = p.render(mode, spp, next(seed))
         rate[p.name] = r["samples"] / r["seconds"]
         spp = max(1, round(0.25 * args.budget * rate[p.name] / pixels))
-        spp = p.round_spp(spp) if hasattr(p, "round_spp") else spp
         p.render(mode, spp, next(seed))  # warm-up at this spp (Mitsuba LLVM: compile)
         r = p.render(mode, spp, next(seed))
         rate[p.name] = r["samples"] / r["seconds"]
         log(f"  {p.name:16s} ~{rate[p.name] / 1e6:.3f} M samples/s")
     for p in peers:
         spp = max(1, round(args.budget * rate[p.name] / pixels))
-        budget_spp[p.name] = p.round_spp(spp) if hasattr(p, "round_spp") else spp
+        budget_spp[p.name] = spp
     # converged references and the agreement check
     refs, ref_info = {}, {}
     log(f"### {scene_name} / {mode}: references ({args.ref_factor} x budget spp)")
     for p in peers:
         spp = budget_spp[p.name]
         p.render(mode, spp, next(seed))  # untimed warm-up at the budget spp (LLVM: its kernel)
-        ref_spp = p.round_spp(spp * args.ref_factor) if hasattr(p, "round_spp") else spp * args.ref_factor
+        if p.name == "tesela-1t" and "tesela" in refs:
+            continue  # same renderer and image statistics: it shares Tesela's reference
+        ref_spp = spp * args.ref_factor
         r = p.render(mode, ref_spp, next(seed))
         refs[p.name] = r["image"]
         ref_info[p.name] = {"spp": ref_spp, "seconds": r["seconds"],
                             "mean": float(r["image"].mean()),
                             "channel_means": r["image"].reshape(-1, 3).mean(axis=0).tolist()}
         log(f"  {p.name:16s} {ref_spp} spp in {r['seconds']:.2f} s, mean {ref_info[p.name]['mean']:.5f}")
+    if "tesela-1t" in budget_spp and "tesela-1t" not in refs:
+        refs["tesela-1t"] = refs["tesela"]
+        ref_info["tesela-1t"] = dict(ref_info["tesela"], shared=True)
     base = "tesela" if "tesela" in refs else next(iter(refs))
-    agree = []
+    b0 = "tesela" if "tesela" in ref_info else next(iter(ref_info))
+    log(f"### {scene_name} / {mode}: agreement of converged means (ratio to {b0}; must be within 1%)")
     for name, info in ref_info.items():
-        ch = np.array(info["channel_means"]) / np.array(ref_info[base]["channel_means"])
-        agree.append({"peer": name, "spp": info["spp"], "mean": info["mean"],
-                      "ratio": info["mean"] / ref_info[base]["mean"],
-                      "channel_ratios": ch.tolist(),
-                      "relmse_vs_" + base: rel_mse(refs[name], refs[base]),
-                      "ok": bool(abs(info["mean"] / ref_info[base]["mean"] - 1) <= 0.01
-                                 and np.all(np.abs(ch - 1) <= 0.01))})
+        ratio = info["mean"] / ref_info[b0]["mean"]
+        log(f"  {name:16s} mean {info['mean']:.5f}  ratio {ratio:.4f}"
+            + ("" if abs(ratio - 1) <= 0.01 else "  ** DISAGREES: renders something else? **"))
     # timed runs, alternating
     runs = {p.name: [] for p in peers}
     log(f"### {scene_name} / {mode}: timed runs, {args.repeats} repeats, budget {args.budget} s")
@@ -366,11 +356,27 @@ def bench_mode(peers, scene_name, mode, args, W, H):
             # scale to exactly the budget (variance ~ 1/time).
             err = raw / (1 + spp / n_ref) * (r["seconds"] / args.budget)
             runs[p.name].append({"spp": spp, "seconds": r["seconds"], "samples": r["samples"],
+                                 "mean": float(r["image"].mean()),
+                                 "loadavg_1min": os.getloadavg()[0],
                                  "sps": r["samples"] / r["seconds"],
                                  "rps": (r["rays"] / r["seconds"]) if r["rays"] else None,
                                  "setup_s": r["setup_s"], "relmse_raw": raw, "relmse_T": err})
             log(f"  [{rep + 1}/{args.repeats}] {p.name:16s} {spp:5d} spp {r['seconds']:7.3f} s "
                 f"{r['samples'] / r['seconds'] / 1e6:7.3f} M samples/s  relMSE@T {err:.3e}")
+    agree = []
+    for name, info in ref_info.items():
+        ch = np.array(info["channel_means"]) / np.array(ref_info[base]["channel_means"])
+        # noise of the reference's mean, from the spread of the timed runs' means
+        tm = [r["mean"] for r in runs.get(name, [])]
+        sem = (statistics.stdev(tm) * math.sqrt(budget_spp[name] / info["spp"])
+               if len(tm) > 1 else float("nan"))
+        agree.append({"peer": name, "spp": info["spp"], "mean": info["mean"], "mean_sd": sem,
+                      "shared_reference": bool(info.get("shared")),
+                      "ratio": info["mean"] / ref_info[base]["mean"],
+                      "channel_ratios": ch.tolist(),
+                      "relmse_vs_" + base: rel_mse(refs[name], refs[base]),
+                      "ok": bool(abs(info["mean"] / ref_info[base]["mean"] - 1) <= 0.01
+                                 and np.all(np.abs(ch - 1) <= 0.01))})
     return {"scene": scene_name, "mode": mode, "width": W, "height": H, "budget_s": args.budget,
             "budget_spp": budget_spp, "agreement": agree, "agreement_base": base,
             "compile_s": compile_s, "runs": runs}
@@ -383,10 +389,11 @@ def tables(result, setup):
     out = [f"#### {s} — {m} ({result['width']}x{result['height']}, budget {result['budget_s']} s)", "",
            f"Converged images (mean over pixels and RGB; ratio to {base}; pass = mean and every "
            "channel within 1%):", "",
-           f"| peer | spp | mean | ratio | R/G/B ratios | relMSE vs {base} | agree |",
+           f"| peer | spp | mean ± sd (est.) | ratio | R/G/B ratios | relMSE vs {base} | agree |",
            "|---|---:|---:|---:|---|---:|---|"]
     for a in result["agreement"]:
-        out.append(f"| {a['peer']} | {a['spp']} | {a['mean']:.5f} | {a['ratio']:.4f} | "
+        out.append(f"| {a['peer']} | {a['spp']}{' (shared)' if a['shared_reference'] else ''} | "
+                   f"{a['mean']:.5f} ± {a['mean_sd']:.5f} | {a['ratio']:.4f} | "
                    + "/".join(f"{c:.4f}" for c in a["channel_ratios"])
                    + f" | {a['relmse_vs_' + base]:.2e} | {'yes' if a['ok'] else '**NO**'} |")
     out += ["", "Timed runs (median (min–max) over repeats; render time only):", "",
