@@ -392,8 +392,8 @@ def tables(result, setup):
            f"| peer | spp | mean ± sd (est.) | ratio | R/G/B ratios | relMSE vs {base} | agree |",
            "|---|---:|---:|---:|---|---:|---|"]
     for a in result["agreement"]:
-        out.append(f"| {a['peer']} | {a['spp']}{' (shared)' if a['shared_reference'] else ''} | "
-                   f"{a['mean']:.5f} ± {a['mean_sd']:.5f} | {a['ratio']:.4f} | "
+        out.append(f"| {a['peer']} | {a['spp']}{' (shared)' if a.get('shared_reference') else ''} | "
+                   f"{a['mean']:.5f} ± {a.get('mean_sd', float('nan')):.5f} | {a['ratio']:.4f} | "
                    + "/".join(f"{c:.4f}" for c in a["channel_ratios"])
                    + f" | {a['relmse_vs_' + base]:.2e} | {'yes' if a['ok'] else '**NO**'} |")
     out += ["", "Timed runs (median (min–max) over repeats; render time only):", "",
@@ -418,7 +418,8 @@ def tables(result, setup):
         if name == "mitsuba-llvm" and result["compile_s"].get(name) is not None:
             setup_bits.append(f"JIT ~{result['compile_s'][name]:.2f} (1st render − 2nd)")
         out.append(
-            f"| {name} | {runs[0]['spp']} | {fmt_range([r['seconds'] for r in runs])} | "
+            f"| {name} | {fmt_range([r['spp'] for r in runs])} | "
+            f"{fmt_range([r['seconds'] for r in runs])} | "
             f"{fmt_range([r['sps'] for r in runs], 1e-6)} | "
             f"{fmt_range(rps, 1e-6) if rps else 'n/a'} | "
             f"{fmt_range([r['relmse_T'] for r in runs])} | "
@@ -456,6 +457,53 @@ def targets(results):
     return "\n".join(lines)
 
 
+def merge(args):
+    """Pool the timed runs of several result files (same scenes and modes) into one table each;
+    the agreement tables of every run are kept."""
+    docs = [json.loads(Path(f).read_text()) for f in args.merge]
+    pooled, order = {}, []
+    for d in docs:
+        for r in d["results"]:
+            key = (r["scene"], r["mode"])
+            if key not in pooled:
+                pooled[key] = dict(r, runs={k: list(v) for k, v in r["runs"].items()},
+                                   agreements=[r["agreement"]])
+                order.append(key)
+            else:
+                p = pooled[key]
+                for k, v in r["runs"].items():
+                    p["runs"].setdefault(k, []).extend(v)
+                p["agreements"].append(r["agreement"])
+    head = (f"# Tesela vs peers — {len(docs)} runs pooled\n\n"
+            + "\n".join(f"- `{Path(f).name}`: {d['env'].get('date')}, load average at start/end "
+                        f"{d['env'].get('load_avg_start', [None])[0]:.1f} / "
+                        f"{(d['env'].get('load_avg_end') or [float('nan')])[0]:.1f}, "
+                        f"tesela {d['env'].get('tesela_commit')}"
+                        for f, d in zip(args.merge, docs)) + "\n")
+    parts = [head]
+    results = []
+    for key in order:
+        r = pooled[key]
+        for i, ag in enumerate(r["agreements"][1:], 2):
+            r.setdefault("extra_agreement", []).append((i, ag))
+        t = tables(r, r.get("setup", {}))
+        for i, ag in r.get("extra_agreement", []):
+            t += f"\n\nAgreement in run {i}: " + ", ".join(
+                f"{a['peer']} {a['ratio']:.4f}{'' if a['ok'] else ' **NO**'}" for a in ag)
+        parts.append(t)
+        results.append(r)
+    tgt = targets(results)
+    text = "\n\n".join(parts) + "\n\n### Targets (issue 5; ratios of pooled medians)\n\n" + tgt + "\n"
+    print(text)
+    if args.out:
+        out = Path(args.out)
+        if out.suffix != ".md":
+            out.mkdir(parents=True, exist_ok=True)
+            out = out / "peers-pooled.md"
+        out.write_text(text)
+        print(f"wrote {out}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="tiny sizes: a smoke run")
@@ -474,7 +522,12 @@ def main():
     ap.add_argument("--tesela", default=str(REPO / "target/release/tesela"))
     ap.add_argument("--out", default=None, help="directory for the .md/.json result "
                     "(default bench/results; quick: a temporary directory)")
+    ap.add_argument("--merge", nargs="+", metavar="JSON",
+                    help="no rendering: pool the timed runs of earlier full runs' .json files "
+                         "and print (and with --out, write) the combined tables")
     args = ap.parse_args()
+    if args.merge:
+        return merge(args)
     q = args.quick
     args.repeats = args.repeats or (2 if q else 5)
     args.budget = args.budget or (0.2 if q else 2.0)
