@@ -236,6 +236,10 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
         session = RenderSession()
         try:
             self._render(depsgraph, scene, settings, width, height, region, rw, rh, session)
+        except Exception as exc:  # noqa: BLE001 - never take Blender down, always say why
+            import traceback
+            traceback.print_exc()
+            self._fail("internal error in the add-on: %s: %s" % (type(exc).__name__, exc))
         finally:
             session.close()
 

@@ -8,6 +8,7 @@ job, saves the Render Result as a linear EXR, writes a JSON status and quits Ble
 """
 
 import json
+import os
 import sys
 import threading
 import time
@@ -73,5 +74,23 @@ def tick():
         finish()
     return None
 
+
+# Optionally take the renderer from the add-on preferences instead of the environment, so the
+# preference lookup runs in the render job thread too.
+_pref = os.environ.pop("TESELA_F12_PREF_BINARY", None)
+if _pref:
+    os.environ.pop("TESELA_BINARY", None)
+    os.environ.pop("TESELA_BIN", None)
+    try:
+        import addon_utils
+        # --addons enables without listing the add-on in the preferences; list it.
+        addon_utils.enable("tesela", default_set=True)
+        bpy.context.preferences.use_preferences_save = False  # never write userpref.blend
+        bpy.context.preferences.addons["tesela"].preferences.binary_path = _pref
+    except Exception as exc:  # noqa: BLE001 - report and quit rather than hang
+        state["error"] = "cannot set the preference: %r" % exc
+        with open(STATUS, "w") as f:
+            json.dump(state, f)
+        bpy.ops.wm.quit_blender()
 
 bpy.app.timers.register(tick, first_interval=1.0)

@@ -45,6 +45,11 @@ def env34(tmp_path_factory):
                     ignore=shutil.ignore_patterns("__pycache__"))
     env = dict(os.environ)
     env["BLENDER_USER_SCRIPTS"] = str(scripts)
+    # Private preferences and recent-files list: the tests never touch the user's own
+    # (Blender 3.4 ignores BLENDER_USER_CONFIG; it follows XDG_CONFIG_HOME / HOME).
+    env["BLENDER_USER_CONFIG"] = str(base / "user config")
+    env["XDG_CONFIG_HOME"] = str(base / "xdg config")
+    env["HOME"] = str(base / "home")
     env.pop("TESELA_BIN", None)
     return base, env
 
@@ -158,6 +163,21 @@ def test_f12_gui_fake(env34):
     assert st["render_pre_thread_is_main"] is False  # render() ran in the job thread
     assert np.array_equal(imgcompare.read_exr(out), fake_pattern(40, 24))
     assert leftovers(tmp) == []
+
+
+def test_f12_gui_binary_from_preferences(env34):
+    """The renderer path set in the add-on preferences (with spaces and non-ASCII characters),
+    looked up from the render job thread."""
+    base, env = env34
+    blend = make_scene(base, env, "f12 pref.blend", w=24, h=16)
+    odd = base / "prëfs bin" / "my tesela"
+    odd.parent.mkdir()
+    shutil.copy(FAKE, odd)
+    odd.chmod(0o755)
+    st, out, tmp, p = f12(base, env, blend, "/nonexistent/tesela", "pref",
+                          {"TESELA_F12_PREF_BINARY": str(odd)})
+    assert st["error"] is None and st["complete"], (st, p.stdout[-2000:])
+    assert np.array_equal(imgcompare.read_exr(out), fake_pattern(24, 16))
 
 
 def test_f12_gui_renderer_error_does_not_hang(env34):
