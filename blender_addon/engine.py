@@ -271,7 +271,8 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
         if binary is None:
             self._fail(preferences.not_found_message(tried))
             return
-        result = self.begin_result(0, 0, rw, rh)
+        # Blender calls render() once per view layer; fill that layer.
+        result = self.begin_result(0, 0, rw, rh, layer=depsgraph.view_layer.name)
         target = compat.combined_pass(result)
         if (result.resolution_x, result.resolution_y) != (rw, rh) and region is not None:
             # Blender rounded the border differently: follow the result it allocated,

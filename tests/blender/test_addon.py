@@ -876,3 +876,26 @@ def test_cancel_during_export_of_a_big_mesh(addon, fake, private_tmp, monkeypatc
     assert end - record["first_true"] < 0.5, "export cancel took %.2f s" % (end - record["first_true"])
     assert fake() == []
     assert os.listdir(private_tmp) == []
+
+
+def test_two_view_layers(addon, fake, private_tmp, tmp_path):
+    """render() runs once per view layer; each fills its own layer."""
+    scene = simple_scene(width=16, height=8)
+    second = scene.view_layers.new("Second Layer")
+    try:
+        assert render() == {"FINISHED"}
+        assert len(fake()) == 2
+        # save_render writes the first layer; the second got its own renderer run
+        assert np.array_equal(result_pixels(tmp_path), fake_pattern(16, 8))
+    finally:
+        scene.view_layers.remove(second)
+    assert os.listdir(private_tmp) == []
+
+
+def test_export_selection_only(addon, tmp_path):
+    scene = simple_scene()
+    for ob in scene.objects:
+        ob.select_set(ob.name == "Cube")
+    doc = _export(tmp_path / "sel.gltf", use_selection=True)
+    names = {n["name"] for n in doc["nodes"]}
+    assert names == {"Cube", "Cam"}
