@@ -18,6 +18,9 @@ import bpy
 argv = sys.argv[sys.argv.index("--") + 1:]
 OUT, STATUS = argv[0], argv[1]
 TIMEOUT = float(argv[2]) if len(argv) > 2 else 120.0
+# Optional: quit Blender this many seconds after the render started (the user closing
+# Blender mid-render; Blender stops the render job, i.e. test_break() turns true).
+QUIT_AFTER = float(argv[3]) if len(argv) > 3 else None
 state = {"started": False, "render_pre_thread_is_main": None, "complete": False,
          "cancelled": False, "t0": None, "error": None, "version": bpy.app.version_string}
 
@@ -64,8 +67,15 @@ def tick():
             state["started"] = True
             return 0.1
         running = bpy.app.is_job_running("RENDER")
+        if running and QUIT_AFTER is not None and time.monotonic() - state["t0"] >= QUIT_AFTER:
+            state["quit_at"] = time.time()
+            with open(STATUS, "w") as f:
+                json.dump(state, f)
+            bpy.ops.wm.quit_blender()
+            return None
         if running and time.monotonic() - state["t0"] < TIMEOUT:
-            return 0.1
+            return 0.02
+        state["job_ended_at"] = time.time()
         if running:
             state["error"] = "timeout"
         finish()

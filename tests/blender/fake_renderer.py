@@ -65,6 +65,10 @@ def watch_stdin():
 
 
 def cancelled(out):
+    log = os.environ.get("FAKE_TESELA_LOG")
+    if log:
+        with open(log, "a", encoding="utf-8") as f:
+            f.write(json.dumps({"pid": os.getpid(), "cancelled_at": time.time()}) + "\n")
     sys.stderr.write("CANCELLED\n")
     sys.stderr.flush()
     os._exit(130)

@@ -137,7 +137,7 @@ def test_background_animation_no_leaks(env34):
     assert leftovers(tmp) == []
 
 
-def f12(base, env, blend, binary, tag, extra_env=None, timeout=120):
+def f12(base, env, blend, binary, tag, extra_env=None, timeout=120, quit_after=None):
     if XVFB is None:
         pytest.skip("xvfb-run not installed")
     tmp = private_tmp(base, "tmp f12 " + tag)
@@ -146,10 +146,12 @@ def f12(base, env, blend, binary, tag, extra_env=None, timeout=120):
     env = dict(env, TESELA_BINARY=str(binary), **(extra_env or {}))
     # TMPDIR only for Blender: xvfb-run keeps its X authority file in TMPDIR and cannot
     # cope with the spaces in ours.
-    p = run([XVFB, "-a", "-s", "-screen 0 1280x1024x24", "env", "TMPDIR=" + str(tmp),
-             BLENDER, "--addons", "tesela", str(blend),
-             "--python", str(HERE / "blender34_f12.py"), "--", str(out), str(status), str(timeout)],
-            env, timeout=timeout + 60)
+    cmd = [XVFB, "-a", "-s", "-screen 0 1280x1024x24", "env", "TMPDIR=" + str(tmp),
+           BLENDER, "--addons", "tesela", str(blend)]
+    cmd += ["--python", str(HERE / "blender34_f12.py"), "--", str(out), str(status), str(timeout)]
+    if quit_after is not None:
+        cmd.append(str(quit_after))
+    p = run(cmd, env, timeout=timeout + 60)
     assert status.is_file(), p.stdout[-3000:] + p.stderr[-3000:]
     st = json.loads(status.read_text())
     return st, out, tmp, p
@@ -272,4 +274,25 @@ def test_two_blenders_render_at_once(env34):
     for i in range(2):
         img = imgcompare.read_exr(base / ("twice%d_001.exr" % i))
         assert np.array_equal(img, fake_pattern(32, 32))
+    assert leftovers(tmp) == []
+
+
+def test_f12_gui_quitting_blender_mid_render(env34):
+    """The user quits Blender while F12 renders: Blender stops the render job (test_break()),
+    the renderer is cancelled (not orphaned), nothing is left behind. (Blender itself spends
+    about a second on its quit sequence before it stops the job; the 0.5 s from test_break()
+    to a stopped renderer is measured by test_addon.py::test_cancel_stops_renderer_quickly.)"""
+    import time
+    base, env = env34
+    blend = make_scene(base, env, "f12 quit.blend", w=64, h=64)
+    log = base / "quit-runs.jsonl"
+    st, out, tmp, p = f12(base, env, blend, FAKE, "quit",
+                          {"FAKE_TESELA_MODE": "slow", "FAKE_TESELA_DELAY": "0.3",
+                           "FAKE_TESELA_LOG": str(log)}, quit_after=2.0)
+    assert st["error"] is None and "quit_at" in st and not st["complete"], st
+    lines = [json.loads(line) for line in log.read_text().splitlines()]
+    ends = [ln for ln in lines if "cancelled_at" in ln]
+    assert ends, "the renderer was not cancelled through stdin/SIGTERM: %s" % lines
+    assert ends[0]["cancelled_at"] - st["quit_at"] < 3.0, (st, ends)
+    assert _zombie_or_gone(lines[0]["pid"])
     assert leftovers(tmp) == []
