@@ -223,7 +223,7 @@ impl RenderScene {
             if dist <= 0.0 || !dist.is_finite() {
                 return true;
             }
-            !self.accel.occluded(o, d / dist, 0.0, dist * (1.0 - 1e-5))
+            !self.accel.occluded(o, d / dist, 0.0, dist * (1.0 - 1e-6))
         } else {
             !self.accel.occluded(o, rec.wi, 0.0, f32::INFINITY)
         }

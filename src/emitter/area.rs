@@ -12,6 +12,9 @@ use crate::texture;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
+/// Smallest barycentric weight of a sampled point (see [`AreaEmitter::sample_point`]).
+pub const EDGE_MARGIN: f32 = 1e-5;
+
 #[derive(Clone, Debug)]
 pub struct AreaEmitter {
     /// Index of the emissive mesh in [`Scene::meshes`].
@@ -77,7 +80,13 @@ impl AreaEmitter {
     pub fn sample_point(&self, mesh: &Mesh, u: Vec2) -> (Vec3, Vec3, Vec3, Vec2) {
         let (tri, ux) = self.cdf.sample_reuse(u.x);
         let b = square_to_uniform_triangle(Vec2::new(ux, u.y));
-        let (b1, b2) = (b.x, b.y);
+        // Keep the point off the triangle's edges, where a light that touches other geometry
+        // would end its shadow ray exactly on that geometry (a leak). This trims a band of
+        // relative area 6e-5 next to the edges.
+        let (b1, b2) = (
+            b.x * (1.0 - 3.0 * EDGE_MARGIN) + EDGE_MARGIN,
+            b.y * (1.0 - 3.0 * EDGE_MARGIN) + EDGE_MARGIN,
+        );
         let b0 = 1.0 - b1 - b2;
         let [i0, i1, i2] = mesh.indices[tri].map(|i| i as usize);
         let p = mesh.positions[i0] * b0 + mesh.positions[i1] * b1 + mesh.positions[i2] * b2;
