@@ -545,7 +545,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     khr_lights = []
 
     def mat_idx(mat):
-        key = mat.name if mat is not None else None
+        key = getattr(mat, "name_full", mat.name) if mat is not None else None
         if key in material_index:
             return material_index[key]
         if mat is None:
@@ -626,6 +626,11 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             mi, ntri = cached
             res.triangles += ntri
             add_node({"name": obj.name, "mesh": mi, "matrix": _gltf_matrix(_matrix(inst.matrix_world))})
+        elif otype in ("CURVES", "POINTCLOUD", "VOLUME", "GPENCIL", "GREASEPENCIL"):
+            if ("skip", otype) not in mesh_cache:
+                mesh_cache[("skip", otype)] = None
+                warnings.append("%s objects are not supported; '%s' (and any others) left out"
+                                % (otype.lower(), obj.name))
         elif otype == "LIGHT":
             ext, khr = convert_light(obj.data, obj, _matrix(inst.matrix_world), warnings)
             node = {"name": obj.name, "matrix": _gltf_matrix(_matrix(inst.matrix_world)),

@@ -69,7 +69,8 @@ def fake(monkeypatch, tmp_path):
     def runs():
         if not log.exists():
             return []
-        return [json.loads(line) for line in log.read_text().splitlines() if line.strip()]
+        lines = [json.loads(line) for line in log.read_text().splitlines() if line.strip()]
+        return [ln for ln in lines if "argv" in ln]  # not the "cancelled_at" lines
     return runs
 
 
