@@ -267,11 +267,11 @@ pub fn glass_pane() -> Scene {
     let dark = add_material(&mut scene, Material::diffuse("wall", Vec3::splat(0.1)));
     let warm = add_material(
         &mut scene,
-        Material::emitter("warm", Vec3::new(6.0, 3.0, 1.0), false),
+        Material::emitter("warm", Vec3::new(2.4, 1.2, 0.4), false),
     );
     let cool = add_material(
         &mut scene,
-        Material::emitter("cool", Vec3::new(1.0, 2.5, 6.0), false),
+        Material::emitter("cool", Vec3::new(0.4, 1.0, 2.4), false),
     );
     let glass = add_material(&mut scene, Material::glass("glass", 1.5));
     let v = Vec3::new;
@@ -303,10 +303,10 @@ pub fn glass_pane() -> Scene {
             v(x0 + 0.05, 1.7, -0.99),
         ));
     }
-    // A 1.2 × 1.0 × 0.04 m slab, tilted 35° about X and 20° about Y.
-    let mut pane = block("glass pane", glass, Vec3::ZERO, v(1.2, 1.0, 0.04), 0.0);
+    // A 1.2 × 1.0 × 0.12 m slab, tilted 40° about X and 30° about Y.
+    let mut pane = block("glass pane", glass, Vec3::ZERO, v(1.2, 1.0, 0.12), 0.0);
     // The block helper leaves out the bottom face; close the slab with it.
-    let h = v(0.6, 0.0, 0.02);
+    let h = v(0.6, 0.0, 0.06);
     let bi = pane.positions.len() as u32;
     pane.positions.extend([
         v(-h.x, 0.0, -h.z),
@@ -318,8 +318,8 @@ pub fn glass_pane() -> Scene {
     pane.indices.push([bi, bi + 1, bi + 2]);
     pane.indices.push([bi, bi + 2, bi + 3]);
     let t = Mat4::from_translation(v(0.0, 0.45, 0.1))
-        * Mat4::from_rotation_y(20f32.to_radians())
-        * Mat4::from_rotation_x(-35f32.to_radians());
+        * Mat4::from_rotation_y(30f32.to_radians())
+        * Mat4::from_rotation_x(-40f32.to_radians());
     for p in &mut pane.positions {
         *p = t.transform_point3(*p);
     }
