@@ -478,8 +478,15 @@ def merge(args):
             + "\n".join(f"- `{Path(f).name}`: {d['env'].get('date')}, load average at start/end "
                         f"{d['env'].get('load_avg_start', [None])[0]:.1f} / "
                         f"{(d['env'].get('load_avg_end') or [float('nan')])[0]:.1f}, "
-                        f"tesela {d['env'].get('tesela_commit')}"
+                        f"tesela {d['env'].get('tesela_commit')}, binary "
+                        f"{d['env'].get('tesela_binary_mtime')} "
+                        f"{d['env'].get('tesela_binary_sha256', '')}"
                         for f, d in zip(args.merge, docs)) + "\n")
+    bins = {(d["env"].get("tesela_binary_mtime"), d["env"].get("tesela_binary_sha256"))
+            for d in docs}
+    if len(bins) > 1:
+        head += ("\n**Warning: these runs measured different Tesela binaries** (the pooled "
+                 "Tesela numbers mix them).\n")
     parts = [head]
     results = []
     for key in order:
@@ -579,6 +586,9 @@ def main():
     try:
         env["tesela_commit"] = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"],
                                               capture_output=True, text=True).stdout.strip()
+        if binary.exists():
+            import hashlib
+            env["tesela_binary_sha256"] = hashlib.sha256(binary.read_bytes()).hexdigest()[:16]
         env["tesela_binary_mtime"] = _dt.datetime.fromtimestamp(
             Path(args.tesela).stat().st_mtime, _dt.timezone.utc).isoformat(timespec="seconds")
         import bpy as _b
