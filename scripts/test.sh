@@ -38,13 +38,13 @@ log "cargo fmt --check"
 cargo fmt --check
 
 log "cargo clippy --all-targets -- -D warnings"
-cargo clippy -q --release --all-targets -- -D warnings
+cargo clippy -q --profile ci --all-targets -- -D warnings
 
 log "cargo build --release"
 cargo build -q --release
 
-log "cargo test --release"
-cargo test -q --release 2>&1 | tee "${TMPDIR:-/tmp}/tesela-cargo-test.log"
+log "cargo test (optimized, profile ci)"
+cargo test -q --profile ci
 
 log "pytest tests/blender"
 export TESELA_BIN="$ROOT/target/release/tesela"
