@@ -232,7 +232,7 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
         settings = scene.tesela
         width, height = export.render_size(r)
         region = export.border_region(r, width, height)
-        rx, ry, rw, rh = region if region is not None else (0, 0, width, height)
+        _, _, rw, rh = region if region is not None else (0, 0, width, height)
         session = RenderSession()
         try:
             self._render(depsgraph, scene, settings, width, height, region, rw, rh, session)
