@@ -82,18 +82,24 @@ def main():
     ap.add_argument("--tile", type=int, default=64, help="tile edge for the fake renderer")
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
+    tmp = tempfile.mkdtemp(prefix="tesela-bench-")
+    try:
+        run(args, tmp)
+    finally:
+        import shutil
+        shutil.rmtree(tmp, ignore_errors=True)
 
+
+def run(args, tmp):
     import bpy
     import numpy as np
     import blender_addon
     from blender_addon import compat
 
-    tmp = tempfile.mkdtemp(prefix="tesela-bench-")
     scene = bpy.context.scene
     if not blender_addon.engine.TeselaRenderEngine.is_registered:
         blender_addon.register()
     gltf = os.path.join(tmp, "bench.gltf")
-    cam = scene.camera
     bpy.ops.export_scene.tesela_gltf(filepath=gltf)
     cmd = producer_cmd(args, gltf)
     env = producer_env(args)
@@ -165,8 +171,6 @@ def main():
     print("(4) paste all tiles into the mirror:      %.3f s" % t_paste)
     print("    rect.foreach_set of the 4K frame:     %.3f s" % t_set)
     print("    update_result of the 4K frame:        %.3f s" % t_update)
-    import shutil
-    shutil.rmtree(tmp, ignore_errors=True)
 
 
 if __name__ == "__main__":
