@@ -90,19 +90,53 @@ fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
     laine_karras(x.reverse_bits(), seed).reverse_bits()
 }
 
-/// Second dimension of the Sobol sequence (generator: Pascal's triangle mod 2).
-#[inline]
-fn sobol1(mut i: u32) -> u32 {
-    let mut v = 1u32 << 31;
-    let mut r = 0;
-    while i != 0 {
-        if i & 1 != 0 {
-            r ^= v;
-        }
-        i >>= 1;
-        v ^= v >> 1;
+/// Direction numbers of Sobol's second dimension: `v[0] = 2^31`, `v[k] = v[k-1] ^ (v[k-1] >> 1)`.
+const fn sobol1_directions() -> [u32; 32] {
+    let mut v = [0u32; 32];
+    v[0] = 1 << 31;
+    let mut k = 1;
+    while k < 32 {
+        v[k] = v[k - 1] ^ (v[k - 1] >> 1);
+        k += 1;
     }
-    r
+    v
+}
+
+/// `SOBOL1_BYTES[b][x]`: XOR of the direction numbers selected by byte `b` of an index equal to `x`.
+const fn sobol1_byte_tables() -> [[u32; 256]; 4] {
+    let v = sobol1_directions();
+    let mut t = [[0u32; 256]; 4];
+    let mut b = 0;
+    while b < 4 {
+        let mut x = 0;
+        while x < 256 {
+            let mut r = 0u32;
+            let mut bit = 0;
+            while bit < 8 {
+                if x & (1 << bit) != 0 {
+                    r ^= v[8 * b + bit];
+                }
+                bit += 1;
+            }
+            t[b][x] = r;
+            x += 1;
+        }
+        b += 1;
+    }
+    t
+}
+
+static SOBOL1_BYTES: [[u32; 256]; 4] = sobol1_byte_tables();
+
+/// Second dimension of the Sobol sequence (generator: Pascal's triangle mod 2), four table
+/// lookups per point.
+#[inline]
+fn sobol1(i: u32) -> u32 {
+    let b = i.to_le_bytes();
+    SOBOL1_BYTES[0][b[0] as usize]
+        ^ SOBOL1_BYTES[1][b[1] as usize]
+        ^ SOBOL1_BYTES[2][b[2] as usize]
+        ^ SOBOL1_BYTES[3][b[3] as usize]
 }
 
 #[inline]
@@ -196,6 +230,22 @@ mod tests {
         let a = SobolSampler::new(5, 1, 0).next_2d();
         let b = SobolSampler::new(5, 2, 0).next_2d();
         assert_ne!(a, b);
+    }
+
+    #[test]
+    fn sobol1_table_matches_definition() {
+        let v = sobol1_directions();
+        for i in [0u32, 1, 2, 3, 255, 256, 0xdead_beef, u32::MAX] {
+            let mut r = 0;
+            for (k, d) in v.iter().enumerate() {
+                if i & (1 << k) != 0 {
+                    r ^= d;
+                }
+            }
+            assert_eq!(sobol1(i), r, "index {i}");
+        }
+        assert_eq!(sobol1(1), 1 << 31);
+        assert_eq!(sobol1(2), 3 << 30);
     }
 
     #[test]
