@@ -1080,3 +1080,68 @@ fn smooth_plastic_coat_probability() {
         }
     }
 }
+
+/// Worst relative difference between an area emitter's triangle choice probability and the
+/// triangle's share of the area, for a UV sphere of `rings × segments`.
+fn worst_triangle_share_error(rings: u32, segments: u32) -> (usize, f64) {
+    let mesh = tesela::scene::builtin::sphere("s", 0, Vec3::ZERO, 1.0, rings, segments);
+    let scene = emitter_scene(vec![mesh], false);
+    let e = AreaEmitter::new(&scene, 0).unwrap();
+    let m = &scene.meshes[0];
+    let areas: Vec<f64> = m
+        .indices
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| m.positions[i as usize].as_dvec3());
+            0.5 * (b - a).cross(c - a).length()
+        })
+        .collect();
+    let total: f64 = areas.iter().sum();
+    let worst = areas
+        .iter()
+        .enumerate()
+        .map(|(i, a)| (e.cdf.pmf(i) as f64 * total / a - 1.0).abs())
+        .fold(0.0, f64::max);
+    let min_pmf = (0..areas.len())
+        .map(|i| e.cdf.pmf(i))
+        .fold(f32::INFINITY, f32::min);
+    println!(
+        "{} triangles: worst relative error of pmf vs area share {worst:.2e}; the smallest \
+         triangle is hit by {} of the 2^24 possible sample values",
+        areas.len(),
+        (min_pmf as f64 * (1u64 << 24) as f64).round()
+    );
+    (areas.len(), worst)
+}
+
+#[test]
+fn area_emitter_triangle_probabilities_match_areas() {
+    // The emitter reports the density 1/A at every point, which is right only if triangle i is
+    // chosen with probability A_i / A. The choice (an f32 CDF driven by a 24-bit uniform number)
+    // quantises probabilities to about 2^-24, fine for meshes of the built-in scenes' density.
+    let (n, worst) = worst_triangle_share_error(48, 96);
+    assert!(
+        worst < 1e-2,
+        "{n} triangles: choice probability off its area share by {worst:.2e}"
+    );
+}
+
+/// Known defect (see the report): on dense emissive meshes the triangle choice probabilities
+/// drift far from the area shares the emitter's pdf assumes (8.8% at 65k triangles, 62% at
+/// 261k), because a triangle's probability is quantised to multiples of about 2^-24.
+/// Run with `--ignored`.
+#[test]
+#[ignore = "known defect: 24-bit triangle choice on dense emissive meshes"]
+fn dense_mesh_emitter_triangle_probabilities_match_areas() {
+    let results = [
+        worst_triangle_share_error(128, 256),
+        worst_triangle_share_error(256, 512),
+    ];
+    for (n, worst) in results {
+        assert!(
+            worst < 1e-2,
+            "{n} triangles: a triangle's choice probability is off its area share by {:.1}%",
+            worst * 100.0
+        );
+    }
+}
