@@ -11,6 +11,12 @@ use obvhs::{
 };
 use std::time::Duration;
 
+/// Largest coordinate magnitude the BVH accepts (metres). Beyond it the builder's surface-area
+/// costs overflow `f32` (obvhs then indexes out of bounds: found by fuzzing), so the loader
+/// refuses such vertices and [`Accel::build`] replaces any triangle reaching past it by an
+/// empty one that no ray hits.
+pub const MAX_COORD: f32 = 1e12;
+
 /// A triangle prepared for intersection: `v0` and the edges `e1 = v1 - v0`, `e2 = v2 - v0`.
 #[derive(Clone, Copy, Debug)]
 struct PackedTriangle {
@@ -81,10 +87,14 @@ impl Accel {
         }
         let input: Vec<Triangle> = triangles
             .iter()
-            .map(|t| Triangle {
-                v0: t[0].into(),
-                v1: t[1].into(),
-                v2: t[2].into(),
+            .map(|t| {
+                let inside = t.iter().all(|v| v.abs().max_element() <= MAX_COORD);
+                let t = if inside { *t } else { [Vec3::ZERO; 3] };
+                Triangle {
+                    v0: t[0].into(),
+                    v1: t[1].into(),
+                    v2: t[2].into(),
+                }
             })
             .collect();
         let mut build_time = Duration::ZERO;
@@ -226,6 +236,27 @@ mod tests {
             );
             assert!(accel.occluded(Vec3::new(0.3, 0.2, 1.0), d, 0.0, 10.0));
         }
+    }
+
+    #[test]
+    fn triangles_beyond_the_coordinate_limit_are_left_out() {
+        // Surface areas beyond f32::MAX once made the CWBVH conversion panic.
+        let mut tris = quad(0.0);
+        for e in [19.5f32, 25.0, 38.0] {
+            let x = 10f32.powf(e);
+            tris.push([Vec3::ZERO, Vec3::new(x, 0.0, 0.0), Vec3::new(0.0, x, 0.0)]);
+        }
+        tris.push([Vec3::ZERO, Vec3::INFINITY, Vec3::NAN]);
+        let accel = Accel::build(&tris);
+        let h = accel
+            .intersect(Vec3::new(0.5, 0.5, 1.0), -Vec3::Z, 0.0, f32::INFINITY)
+            .unwrap();
+        assert!(h.triangle < 2 && (h.t - 1.0).abs() < 1e-6);
+        assert!(
+            accel
+                .intersect(Vec3::new(5.0, 5.0, 1.0), -Vec3::Z, 0.0, f32::INFINITY)
+                .is_none()
+        );
     }
 
     #[test]

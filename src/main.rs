@@ -228,6 +228,12 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
             message: w.clone(),
         });
     }
+    if rscene.triangle_count() == 0 {
+        send(&Message::Log {
+            level: 2,
+            message: "the scene has no triangles: the image shows only the background".into(),
+        });
+    }
     let start = std::time::Instant::now();
     let on_tile = |t: &render::Tile, done: usize, total: usize| {
         let rgba = t.pixels.iter().flatten().copied().collect();
@@ -303,8 +309,11 @@ fn run_render(args: &RenderArgs) -> ExitCode {
     for w in &rscene.scene.warnings {
         eprintln!("tesela: warning: {w}");
     }
-    if rscene.triangle_count() == 0 && rscene.lights.is_empty() {
-        eprintln!("tesela: warning: the scene has no triangles and no lights");
+    if rscene.triangle_count() == 0 {
+        // Not an error: the image shows the background, as Blender shows an empty scene.
+        eprintln!(
+            "tesela: warning: the scene has no triangles: the image shows only the background"
+        );
     }
     let build_s = build.elapsed().as_secs_f64();
     let bar = if args.quiet {
@@ -364,8 +373,19 @@ fn run_render(args: &RenderArgs) -> ExitCode {
     }
 }
 
-/// Refuses an output path whose format is unknown before spending time on the render.
+/// Refuses an output path whose format is unknown, or whose folder does not exist, before
+/// spending time on the render.
 fn check_output(path: &Path) -> Result<(), String> {
+    if let Some(dir) = path.parent()
+        && !dir.as_os_str().is_empty()
+        && !dir.is_dir()
+    {
+        return Err(format!(
+            "{}: the output folder {} does not exist",
+            path.display(),
+            dir.display()
+        ));
+    }
     match path
         .extension()
         .and_then(|e| e.to_str())

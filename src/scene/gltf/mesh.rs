@@ -126,6 +126,16 @@ impl<'a> Loader<'a> {
                     "mesh {mi} primitive {pi} on node {ni}: positions are not finite in world space"
                 ))
             })?;
+            if let Some((i, p)) = positions
+                .iter()
+                .enumerate()
+                .find(|(_, p)| p.abs().max_element() > crate::accel::MAX_COORD)
+            {
+                return Err(invalid(format!(
+                    "mesh {mi} primitive {pi} on node {ni}: vertex {i} at {p} in world space is farther than {:e} m from the origin (the renderer's coordinate limit)",
+                    crate::accel::MAX_COORD
+                )));
+            }
             self.tri_total = self.tri_total.saturating_add(indices.len());
             self.vert_total = self.vert_total.saturating_add(positions.len());
             if self.tri_total > MAX_TRIANGLES || self.vert_total > MAX_VERTICES {
