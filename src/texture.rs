@@ -1,5 +1,7 @@
 //! Texture lookup: bilinear (Cycles' "Linear", no mipmaps) or nearest, with glTF wrap modes.
 //! Texture coordinates follow glTF: `(0, 0)` is the image's top-left corner.
+//! Colour (sRGB) textures are filtered on their encoded values and decoded to linear after
+//! filtering, as Cycles does with 8-bit images.
 
 use crate::scene::{Image, Texture, Wrap};
 use glam::{Vec2, Vec4};
@@ -36,19 +38,34 @@ fn wrap(i: i64, n: u32, mode: Wrap) -> usize {
     r as usize
 }
 
+/// Encoded texel value in [0, 1].
 #[inline]
-fn texel(img: &Image, x: usize, y: usize, srgb: bool) -> Vec4 {
+fn texel(img: &Image, x: usize, y: usize) -> Vec4 {
     let p = img.rgba8[y * img.width as usize + x];
+    Vec4::new(p[0] as f32, p[1] as f32, p[2] as f32, p[3] as f32) / 255.0
+}
+
+/// sRGB decode of a filtered encoded value in [0, 1].
+#[inline]
+fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+#[inline]
+fn decode(v: Vec4, srgb: bool) -> Vec4 {
     if srgb {
-        let t = srgb_table();
         Vec4::new(
-            t[p[0] as usize],
-            t[p[1] as usize],
-            t[p[2] as usize],
-            p[3] as f32 / 255.0,
+            srgb_to_linear(v.x),
+            srgb_to_linear(v.y),
+            srgb_to_linear(v.z),
+            v.w,
         )
     } else {
-        Vec4::new(p[0] as f32, p[1] as f32, p[2] as f32, p[3] as f32) / 255.0
+        v
     }
 }
 
@@ -65,7 +82,17 @@ pub fn lookup(tex: &Texture, img: &Image, uv: Vec2, srgb: bool) -> Vec4 {
     if tex.nearest {
         let xi = wrap((x + 0.5).floor() as i64, img.width, tex.wrap_s);
         let yi = wrap((y + 0.5).floor() as i64, img.height, tex.wrap_t);
-        return texel(img, xi, yi, srgb);
+        let p = img.rgba8[yi * img.width as usize + xi];
+        if srgb {
+            let t = srgb_table();
+            return Vec4::new(
+                t[p[0] as usize],
+                t[p[1] as usize],
+                t[p[2] as usize],
+                p[3] as f32 / 255.0,
+            );
+        }
+        return texel(img, xi, yi);
     }
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
@@ -74,9 +101,9 @@ pub fn lookup(tex: &Texture, img: &Image, uv: Vec2, srgb: bool) -> Vec4 {
     let xb = wrap(x0 + 1, img.width, tex.wrap_s);
     let ya = wrap(y0, img.height, tex.wrap_t);
     let yb = wrap(y0 + 1, img.height, tex.wrap_t);
-    let top = texel(img, xa, ya, srgb).lerp(texel(img, xb, ya, srgb), fx);
-    let bottom = texel(img, xa, yb, srgb).lerp(texel(img, xb, yb, srgb), fx);
-    top.lerp(bottom, fy)
+    let top = texel(img, xa, ya).lerp(texel(img, xb, ya), fx);
+    let bottom = texel(img, xa, yb).lerp(texel(img, xb, yb), fx);
+    decode(top.lerp(bottom, fy), srgb)
 }
 
 #[cfg(test)]
@@ -124,5 +151,8 @@ mod tests {
         assert!((s.x - 1.0).abs() < 1e-6);
         let half = srgb_table()[128];
         assert!((half - 0.2158605).abs() < 1e-5);
+        // Filtering happens before decoding: halfway between red and green is sRGB 0.5.
+        let mid = lookup(&tex, &img, Vec2::new(0.5, 0.25), true);
+        assert!((mid.x - srgb_to_linear(0.5)).abs() < 1e-6, "{mid}");
     }
 }
