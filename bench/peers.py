@@ -76,6 +76,13 @@ def read_exr(path):
     return a.reshape(h, w, 4)[::-1, :, :3].copy()
 
 
+def cpu_seconds(who):
+    """User + system CPU seconds of this process (RUSAGE_SELF) or its finished children."""
+    import resource
+    r = resource.getrusage(who)
+    return r.ru_utime + r.ru_stime
+
+
 def rel_mse(img, ref):
     return float(np.mean((img - ref) ** 2 / (ref ** 2 + EPS)))
 
@@ -101,9 +108,12 @@ class Tesela:
         cmd = [str(self.binary), "render", str(self.gltf), "-o", str(out), "--integrator",
                integrator, "--max-depth", str(depth), "--spp", str(spp), "--width", str(self.w),
                "--height", str(self.h), "--threads", str(self.threads), "--seed", str(seed)]
+        import resource
+        c0 = cpu_seconds(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
         p = subprocess.run(cmd, capture_output=True, text=True)
         wall = time.perf_counter() - t0
+        cpu = cpu_seconds(resource.RUSAGE_CHILDREN) - c0
         m = re.search(r"in ([\d.]+) s \(\+([\d.]+) s BVH\): ([\d.]+) M samples/s, ([\d.]+) M rays/s",
                       p.stderr)
         if p.returncode != 0 or not m:
@@ -114,7 +124,7 @@ class Tesela:
         if msps > 0 and 0.005 / msps < 0.005 / max(secs, 1e-9):
             secs = samples / (msps * 1e6)
         return {"image": read_exr(out), "seconds": secs, "samples": samples,
-                "rays": mrps * 1e6 * secs, "setup_s": bvh, "wall_s": wall}
+                "rays": mrps * 1e6 * secs, "setup_s": bvh, "wall_s": wall, "cpu_s": cpu}
 
 
 class Cycles:
@@ -205,9 +215,12 @@ class Cycles:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, 1)
         try:
+            import resource
+            c0 = cpu_seconds(resource.RUSAGE_SELF)
             t0 = time.perf_counter()
             self.bs.render_cycles(out)
             wall = time.perf_counter() - t0
+            cpu = cpu_seconds(resource.RUSAGE_SELF) - c0
         finally:
             os.dup2(saved, 1)
             os.close(saved)
@@ -219,7 +232,7 @@ class Cycles:
         pre = next(t for t, tag, a in self.events if tag == "pre")
         samples = self.scene.render.resolution_x * self.scene.render.resolution_y * spp
         return {"image": read_exr(out), "seconds": end - start, "samples": samples,
-                "rays": None, "setup_s": start - pre, "wall_s": wall}
+                "rays": None, "setup_s": start - pre, "wall_s": wall, "cpu_s": cpu}
 
 
 class Mitsuba:
@@ -274,13 +287,17 @@ class Mitsuba:
         mi, dr = self.mi, self.dr
         mi.set_variant(self.variant)
         integ = self._integrator(mode)
+        import resource
+        c0 = cpu_seconds(resource.RUSAGE_SELF)
         t0 = time.perf_counter()
         img = mi.render(self.scene, integrator=integ, spp=spp, seed=seed)
         dr.eval(img)
         dr.sync_thread()
         secs = time.perf_counter() - t0
+        cpu = cpu_seconds(resource.RUSAGE_SELF) - c0
         return {"image": np.array(img, dtype=np.float32)[:, :, :3], "seconds": secs,
-                "samples": self.pixels * spp, "rays": None, "setup_s": None, "wall_s": secs}
+                "samples": self.pixels * spp, "rays": None, "setup_s": None, "wall_s": secs,
+                "cpu_s": cpu}
 
 
 # ------------------------------------------------------------------------------------------------
@@ -358,6 +375,7 @@ def bench_mode(peers, scene_name, mode, args, W, H):
             runs[p.name].append({"spp": spp, "seconds": r["seconds"], "samples": r["samples"],
                                  "mean": float(r["image"].mean()),
                                  "loadavg_1min": os.getloadavg()[0],
+                                 "cores_used": r["cpu_s"] / r["wall_s"] if r.get("wall_s") else None,
                                  "sps": r["samples"] / r["seconds"],
                                  "rps": (r["rays"] / r["seconds"]) if r["rays"] else None,
                                  "setup_s": r["setup_s"], "relmse_raw": raw, "relmse_T": err})
@@ -398,8 +416,8 @@ def tables(result, setup):
                    + f" | {a['relmse_vs_' + base]:.2e} | {'yes' if a['ok'] else '**NO**'} |")
     out += ["", "Timed runs (median (min–max) over repeats; render time only):", "",
             "| peer | spp | render s | M samples/s | M rays/s | relMSE at equal time | "
-            "vs tesela (relMSE) | setup s |",
-            "|---|---:|---:|---:|---:|---:|---:|---|"]
+            "vs tesela (relMSE) | cores used | setup s |",
+            "|---|---:|---:|---:|---:|---:|---:|---:|---|"]
     tes = result["runs"].get("tesela")
     tes_err = statistics.median(r["relmse_T"] for r in tes) if tes else None
     for name, runs in result["runs"].items():
@@ -423,7 +441,8 @@ def tables(result, setup):
             f"{fmt_range([r['sps'] for r in runs], 1e-6)} | "
             f"{fmt_range(rps, 1e-6) if rps else 'n/a'} | "
             f"{fmt_range([r['relmse_T'] for r in runs])} | "
-            f"{(err / tes_err) if tes_err else float('nan'):.2f} | {', '.join(setup_bits)} |")
+            f"{(err / tes_err) if tes_err else float('nan'):.2f} | "
+            f"{fmt_range([r.get('cores_used') for r in runs], digits=2)} | {', '.join(setup_bits)} |")
     return "\n".join(out)
 
 
