@@ -78,25 +78,29 @@ fn intersect_triangle(
 impl Accel {
     /// Builds the BVH over `triangles` (world-space vertex triples).
     pub fn build(triangles: &[[Vec3; 3]]) -> Accel {
-        if triangles.is_empty() {
+        Accel::build_from(triangles.len(), triangles.iter().copied())
+    }
+
+    /// Builds the BVH over the `n` triangles of `triangles` without an intermediate copy
+    /// of the scene (a 10-million-triangle scene saves 360 MB at the build's peak).
+    pub fn build_from(n: usize, triangles: impl Iterator<Item = [Vec3; 3]>) -> Accel {
+        let mut input: Vec<Triangle> = Vec::with_capacity(n);
+        input.extend(triangles.map(|t| {
+            let inside = t.iter().all(|v| v.abs().max_element() <= MAX_COORD);
+            let t = if inside { t } else { [Vec3::ZERO; 3] };
+            Triangle {
+                v0: t[0].into(),
+                v1: t[1].into(),
+                v2: t[2].into(),
+            }
+        }));
+        if input.is_empty() {
             return Accel {
                 bvh: CwBvh::default(),
                 tris: Vec::new(),
                 ids: Vec::new(),
             };
         }
-        let input: Vec<Triangle> = triangles
-            .iter()
-            .map(|t| {
-                let inside = t.iter().all(|v| v.abs().max_element() <= MAX_COORD);
-                let t = if inside { *t } else { [Vec3::ZERO; 3] };
-                Triangle {
-                    v0: t[0].into(),
-                    v1: t[1].into(),
-                    v2: t[2].into(),
-                }
-            })
-            .collect();
         let mut build_time = Duration::ZERO;
         let bvh = build_cwbvh_from_tris(&input, BvhBuildParams::medium_build(), &mut build_time);
         let ids = bvh.primitive_indices.clone();

@@ -62,16 +62,19 @@ impl RenderScene {
     /// Builds the BVH and the emitters. Emissive meshes of zero area are skipped with a warning.
     pub fn new(mut scene: Scene, choice: LightChoice) -> RenderScene {
         let n = scene.triangle_count();
-        let mut tris = Vec::with_capacity(n);
+        // Triangles go straight from the meshes into the builder, and the map is made after
+        // the build: neither adds to the build's peak memory.
+        let accel = Accel::build_from(
+            n,
+            scene
+                .meshes
+                .iter()
+                .flat_map(|m| m.indices.iter().map(|t| t.map(|i| m.positions[i as usize]))),
+        );
         let mut tri_map = Vec::with_capacity(n);
         for (mi, m) in scene.meshes.iter().enumerate() {
-            for (ti, t) in m.indices.iter().enumerate() {
-                tris.push(t.map(|i| m.positions[i as usize]));
-                tri_map.push((mi as u32, ti as u32));
-            }
+            tri_map.extend((0..m.indices.len() as u32).map(|ti| (mi as u32, ti)));
         }
-        let accel = Accel::build(&tris);
-        drop(tris);
         let (center, radius) = match scene.bounds() {
             Some((lo, hi)) => ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-3)),
             None => (Vec3::ZERO, 1.0),
