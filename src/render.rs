@@ -91,6 +91,9 @@ impl std::error::Error for RenderError {}
 /// Largest image accepted (pixels): refuse what cannot reasonably be allocated.
 pub const MAX_PIXELS: u64 = 1 << 28;
 
+/// Most worker threads accepted: starting 100,000 threads takes minutes (it looked like a hang).
+pub const MAX_THREADS: usize = 1024;
+
 /// Checks the options before any allocation.
 pub fn validate(opts: &RenderOptions) -> Result<(), RenderError> {
     if opts.width == 0 || opts.height == 0 {
@@ -102,6 +105,12 @@ pub fn validate(opts: &RenderOptions) -> Result<(), RenderError> {
         return Err(RenderError::Invalid(format!(
             "resolution {}x{} is too large (at most {} pixels)",
             opts.width, opts.height, MAX_PIXELS
+        )));
+    }
+    if opts.threads > MAX_THREADS {
+        return Err(RenderError::Invalid(format!(
+            "{} worker threads is too many (at most {MAX_THREADS}; 0 = one per core)",
+            opts.threads
         )));
     }
     if opts.spp == 0 {

@@ -520,6 +520,14 @@ fn absurd_resolution_is_refused_before_allocating() {
         json!({ "TESELA_render": { "width": 4000000000u64, "height": 3000000000u64 } });
     let f = write(&dir, "big.gltf", &to_bytes(&d));
     expect_failure(&["render", &f, "-o", s(&out)], 1, &["is too large"]);
+    // Absurd thread counts are refused instead of spending minutes starting threads.
+    let start = Instant::now();
+    expect_failure(
+        &["render", "--threads", "100000", "-o", s(&out)],
+        1,
+        &["100000 worker threads is too many"],
+    );
+    assert!(start.elapsed() < Duration::from_secs(20));
     // Not a number at all: a usage error.
     let o = run(&["render", "--width", "1e9", "-o", s(&out)], DEADLINE);
     assert_eq!(o.code, 2, "{}", o.stderr);
