@@ -11,8 +11,7 @@ ROOT="$(pwd)"
 log() { printf '\n== %s\n' "$*"; }
 
 if [[ "${TESELA_SKIP_INSTALL:-0}" != 1 ]]; then
-    if ! command -v blender >/dev/null || ! command -v xvfb-run >/dev/null \
-        || ! python3 -c 'import numpy' 2>/dev/null; then
+    if ! dpkg -s blender python3-numpy xvfb >/dev/null 2>&1; then
         log "installing Debian packages: blender python3-numpy xvfb"
         SUDO=""
         [[ "$(id -u)" != 0 ]] && SUDO="sudo"
