@@ -84,6 +84,8 @@ pub fn square_to_uniform_triangle(s: Vec2) -> Vec2 {
 pub struct DiscreteCdf {
     /// `cdf[i]` = sum of weights `[0, i)` normalised; `cdf.len() == n + 1`, `cdf[n] == 1`.
     cdf: Vec<f32>,
+    /// The same table in double precision, for [`DiscreteCdf::sample_fine`].
+    cdf64: Vec<f64>,
     sum: f64,
 }
 
@@ -110,7 +112,18 @@ impl DiscreteCdf {
         } else {
             cdf = vec![0.0; raw.len()];
         }
-        DiscreteCdf { cdf, sum: acc }
+        let cdf64 = if acc > 0.0 {
+            let mut c: Vec<f64> = raw.iter().map(|c| c / acc).collect();
+            *c.last_mut().unwrap() = 1.0;
+            c
+        } else {
+            vec![0.0; raw.len()]
+        };
+        DiscreteCdf {
+            cdf,
+            cdf64,
+            sum: acc,
+        }
     }
 
     /// Number of items.
@@ -157,6 +170,33 @@ impl DiscreteCdf {
         let p = self.pmf(i);
         let r = if p > 0.0 {
             ((u - self.cdf[i]) / p).clamp(0.0, 1.0 - f32::EPSILON / 2.0)
+        } else {
+            0.0
+        };
+        (i, r)
+    }
+}
+
+impl DiscreteCdf {
+    /// Probability of item `i` in double precision.
+    #[inline]
+    pub fn pmf_fine(&self, i: usize) -> f64 {
+        self.cdf64[i + 1] - self.cdf64[i]
+    }
+
+    /// Like [`DiscreteCdf::sample_reuse`] with a uniform `u` in `[0,1)` of up to 53 bits, for
+    /// distributions over so many items (the triangles of a dense emissive mesh) that a 24-bit
+    /// `f32` cannot resolve their probabilities. Returns `(index, u rescaled to [0,1))`.
+    #[inline]
+    pub fn sample_fine(&self, u: f64) -> (usize, f64) {
+        let n = self.len();
+        let mut i = self.cdf64[1..].partition_point(|&c| c <= u).min(n - 1);
+        while self.pmf_fine(i) <= 0.0 && i > 0 {
+            i -= 1;
+        }
+        let p = self.pmf_fine(i);
+        let r = if p > 0.0 {
+            ((u - self.cdf64[i]) / p).clamp(0.0, 1.0 - f64::EPSILON)
         } else {
             0.0
         };

@@ -75,11 +75,31 @@ impl AreaEmitter {
         }
     }
 
+    /// Chooses a triangle with probability proportional to its area, and the two numbers that
+    /// place the point on it. The triangle is chosen with a 48-bit number made of both
+    /// coordinates of `u`, so that the choice stays proportional to area on meshes with millions
+    /// of triangles (a 24-bit number alone quantises every probability to 2^-24); the rescaled
+    /// remainder is split into its high bits and its next bits (for a mesh of one or two
+    /// triangles these are `u.x` and `u.y` again).
+    #[inline]
+    pub fn choose_triangle(&self, u: Vec2) -> (usize, f32, f32) {
+        let t = u.x as f64 + u.y as f64 * (1.0 / 16_777_216.0);
+        let (tri, r) = self.cdf.sample_fine(t);
+        let bits = (48.0 + self.cdf.pmf_fine(tri).log2()).max(2.0);
+        let scale = (bits * 0.5).floor().clamp(1.0, 24.0).exp2();
+        const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
+        (
+            tri,
+            (r as f32).min(BELOW_ONE),
+            ((r * scale).fract() as f32).min(BELOW_ONE),
+        )
+    }
+
     /// Uniform point on the mesh: `(position, shading normal, geometric unit normal, uv)`.
     #[inline]
     pub fn sample_point(&self, mesh: &Mesh, u: Vec2) -> (Vec3, Vec3, Vec3, Vec2) {
-        let (tri, ux) = self.cdf.sample_reuse(u.x);
-        let b = square_to_uniform_triangle(Vec2::new(ux, u.y));
+        let (tri, ua, ub) = self.choose_triangle(u);
+        let b = square_to_uniform_triangle(Vec2::new(ua, ub));
         // Keep the point off the triangle's edges, where a light that touches other geometry
         // would end its shadow ray exactly on that geometry (a leak). This trims a band of
         // relative area 6e-5 next to the edges.
