@@ -75,11 +75,10 @@ impl RenderScene {
         for (mi, m) in scene.meshes.iter().enumerate() {
             tri_map.extend((0..m.indices.len() as u32).map(|ti| (mi as u32, ti)));
         }
-        let (center, radius) = match scene.bounds() {
-            Some((lo, hi)) => ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-3)),
-            None => (Vec3::ZERO, 1.0),
+        let radius = match scene.bounds() {
+            Some((lo, hi)) => ((hi - lo) * 0.5).length().max(1e-3),
+            None => 1.0,
         };
-        let _ = center;
 
         let mut emitters = Vec::new();
         let mut mesh_emitter = vec![None; scene.meshes.len()];
@@ -260,18 +259,16 @@ impl RenderScene {
         }
     }
 
-    /// Radiance emitted by the hit surface towards `-d` (for a ray travelling along `d`),
-    /// with the emitter's index for MIS.
+    /// Radiance emitted by the hit surface towards `from` (the ray's origin), with the
+    /// emitter's index for MIS.
     #[inline]
     pub fn emitted(
         &self,
         its: &Intersection,
-        d: Vec3,
         from: Vec3,
     ) -> Option<(u32, Vec3, EmitterQueryRecord)> {
         let e = its.emitter?;
         let rec = EmitterQueryRecord::between(from, its.p, its.ns, its.ng, its.uv);
-        let _ = d;
         let le = self.emitters[e as usize].eval(&self.scene, &rec);
         Some((e, le, rec))
     }

@@ -2,7 +2,7 @@
 //! surface, one light sample and a shadow ray. Emitters seen directly (or through a chain of
 //! delta bounces) show their radiance.
 
-use super::{Integrator, ShadingPoint, sample_emitter, spawn};
+use super::{Integrator, ShadingPoint, sample_emitter, spawn, trace_emitted};
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
 
@@ -16,15 +16,13 @@ impl Integrator for DirectEms {
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
         loop {
-            let Some(its) = scene.trace(ctx, o, d, depth) else {
-                if let Some((_, le, _)) = scene.background_radiance(d, o) {
-                    l += throughput * le;
-                }
-                return l;
-            };
-            if let Some((_, le, _)) = scene.emitted(&its, d, o) {
+            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth);
+            if let Some((_, le, _)) = emitted {
                 l += throughput * le;
             }
+            let Some(its) = hit else {
+                return l;
+            };
             if depth >= self.max_depth {
                 return l;
             }

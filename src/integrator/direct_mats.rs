@@ -1,7 +1,7 @@
 //! Direct illumination by BSDF sampling (the seed's `direct_mats`): one BSDF sample at the
 //! first non-delta surface; its ray counts the radiance of whatever emitter it hits.
 
-use super::{Integrator, ShadingPoint, spawn};
+use super::{Integrator, ShadingPoint, spawn, trace_emitted};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
@@ -16,15 +16,13 @@ impl Integrator for DirectMats {
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
         loop {
-            let Some(its) = scene.trace(ctx, o, d, depth) else {
-                if let Some((_, le, _)) = scene.background_radiance(d, o) {
-                    l += throughput * le;
-                }
-                return l;
-            };
-            if let Some((_, le, _)) = scene.emitted(&its, d, o) {
+            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth);
+            if let Some((_, le, _)) = emitted {
                 l += throughput * le;
             }
+            let Some(its) = hit else {
+                return l;
+            };
             if depth >= self.max_depth {
                 return l;
             }
@@ -38,17 +36,8 @@ impl Integrator for DirectMats {
             depth += 1;
             if rec.measure != Measure::Discrete {
                 // The one non-delta bounce: count what it sees, then stop.
-                match scene.trace(ctx, o, d, depth) {
-                    Some(next) => {
-                        if let Some((_, le, _)) = scene.emitted(&next, d, o) {
-                            l += throughput * le;
-                        }
-                    }
-                    None => {
-                        if let Some((_, le, _)) = scene.background_radiance(d, o) {
-                            l += throughput * le;
-                        }
-                    }
+                if let (_, Some((_, le, _))) = trace_emitted(scene, ctx, o, d, depth) {
+                    l += throughput * le;
                 }
                 return l;
             }

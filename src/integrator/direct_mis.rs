@@ -3,7 +3,7 @@
 //! heuristic. Delta BSDF samples and delta lights get weight 1 (the other strategy cannot
 //! produce them). The light-choice probability is part of the emitter density on both sides.
 
-use super::{Integrator, ShadingPoint, mis_weight, sample_emitter, spawn};
+use super::{Integrator, ShadingPoint, mis_weight, sample_emitter, spawn, trace_emitted};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
@@ -18,15 +18,13 @@ impl Integrator for DirectMis {
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
         loop {
-            let Some(its) = scene.trace(ctx, o, d, depth) else {
-                if let Some((_, le, _)) = scene.background_radiance(d, o) {
-                    l += throughput * le;
-                }
-                return l;
-            };
-            if let Some((_, le, _)) = scene.emitted(&its, d, o) {
+            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth);
+            if let Some((_, le, _)) = emitted {
                 l += throughput * le;
             }
+            let Some(its) = hit else {
+                return l;
+            };
             if depth >= self.max_depth {
                 return l;
             }
@@ -43,11 +41,7 @@ impl Integrator for DirectMis {
             depth += 1;
             if rec.measure != Measure::Discrete {
                 // The BSDF half of MIS at this vertex, then stop.
-                let hit = match scene.trace(ctx, o, d, depth) {
-                    Some(next) => scene.emitted(&next, d, o),
-                    None => scene.background_radiance(d, o),
-                };
-                if let Some((e, le, erec)) = hit {
+                if let (_, Some((e, le, erec))) = trace_emitted(scene, ctx, o, d, depth) {
                     l += throughput * le * mis_weight(rec.pdf, scene.light_pdf(e, &erec));
                 }
                 return l;

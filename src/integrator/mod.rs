@@ -13,6 +13,7 @@ pub mod path;
 
 use crate::accel::offset_origin;
 use crate::bsdf::{self, Bsdf, BsdfInstance, BsdfQueryRecord};
+use crate::emitter::EmitterQueryRecord;
 use crate::frame::Frame;
 use crate::render_scene::{Ctx, Intersection, RenderScene};
 use glam::Vec3;
@@ -163,6 +164,28 @@ pub fn sample_emitter(
         1.0
     };
     f * weight * w
+}
+
+/// Emitted radiance met by a ray: `(emitter index, radiance, record for MIS)`.
+pub type Emitted = Option<(u32, Vec3, EmitterQueryRecord)>;
+
+/// Traces the ray leaving path vertex `depth - 1` and returns the surface it hits (if any) with
+/// the radiance arriving along it from that surface's emission, or from the background when
+/// the ray escapes.
+#[inline]
+pub fn trace_emitted(
+    scene: &RenderScene,
+    ctx: &mut Ctx,
+    o: Vec3,
+    d: Vec3,
+    depth: u32,
+) -> (Option<Intersection>, Emitted) {
+    let hit = scene.trace(ctx, o, d, depth);
+    let emitted = match &hit {
+        Some(its) => scene.emitted(its, o),
+        None => scene.background_radiance(d, o),
+    };
+    (hit, emitted)
 }
 
 /// Origin for a ray leaving `its` along `wo`.

@@ -2,7 +2,7 @@
 //! BSDF sampling at every vertex, power heuristic). Russian roulette from vertex 4 on, on the
 //! throughput's **maximum** component, survival probability capped at 0.95.
 
-use super::{Integrator, ShadingPoint, mis_weight, sample_emitter, spawn};
+use super::{Integrator, ShadingPoint, mis_weight, sample_emitter, spawn, trace_emitted};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
@@ -38,15 +38,13 @@ impl Integrator for PathMats {
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
         loop {
-            let Some(its) = scene.trace(ctx, o, d, depth) else {
-                if let Some((_, le, _)) = scene.background_radiance(d, o) {
-                    l += throughput * le;
-                }
-                return l;
-            };
-            if let Some((_, le, _)) = scene.emitted(&its, d, o) {
+            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth);
+            if let Some((_, le, _)) = emitted {
                 l += throughput * le;
             }
+            let Some(its) = hit else {
+                return l;
+            };
             if depth >= self.max_depth || !roulette(ctx, depth, &mut throughput) {
                 return l;
             }
@@ -71,11 +69,7 @@ impl Integrator for PathMis {
         // and delta samples (emitter sampling could not have produced them: MIS weight 1).
         let mut bsdf_pdf = f32::INFINITY;
         loop {
-            let hit = scene.trace(ctx, o, d, depth);
-            let emitted = match &hit {
-                Some(its) => scene.emitted(its, d, o),
-                None => scene.background_radiance(d, o),
-            };
+            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth);
             if let Some((e, le, erec)) = emitted {
                 let w = if bsdf_pdf.is_infinite() {
                     1.0
