@@ -212,7 +212,7 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
         send(&Message::Error(e.to_string()));
         return ExitCode::from(EXIT_RENDER);
     }
-    let rscene = RenderScene::new(scene, light_choice(args));
+    let rscene = prepare(scene, light_choice(args), opts.threads);
     let [_, _, rw, rh] = opts.region.unwrap_or([0, 0, opts.width, opts.height]);
     let ts = opts.tile_size.max(1);
     send(&Message::Hello {
@@ -275,6 +275,15 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
     }
 }
 
+/// Builds the BVH and the emitters on `threads` worker threads (0 = one per core), the count
+/// the render itself is given.
+fn prepare(scene: tesela::scene::Scene, choice: LightChoice, threads: usize) -> RenderScene {
+    match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+        Ok(pool) => pool.install(|| RenderScene::new(scene, choice)),
+        Err(_) => RenderScene::new(scene, choice),
+    }
+}
+
 fn light_choice(args: &RenderArgs) -> LightChoice {
     if args.light_choice == "uniform" {
         LightChoice::Uniform
@@ -305,7 +314,7 @@ fn run_render(args: &RenderArgs) -> ExitCode {
         return ExitCode::from(EXIT_RENDER);
     }
     let build = std::time::Instant::now();
-    let rscene = RenderScene::new(scene, light_choice(args));
+    let rscene = prepare(scene, light_choice(args), opts.threads);
     for w in &rscene.scene.warnings {
         eprintln!("tesela: warning: {w}");
     }

@@ -1,7 +1,7 @@
 //! A scene prepared for rendering: the BVH, the emitters and the light-selection
 //! distribution, with the surface queries the integrators need.
 
-use crate::accel::{Accel, offset_origin};
+use crate::accel::{Accel, Hit, offset_origin};
 use crate::bsdf::SurfaceParams;
 use crate::emitter::{
     AreaEmitter, Background, Directional, Emitter, EmitterInstance, EmitterQueryRecord,
@@ -36,6 +36,37 @@ impl Intersection {
     }
 }
 
+/// Emitted radiance met by a ray: `(emitter index, radiance, record for MIS)`.
+pub type Emitted = Option<(u32, Vec3, EmitterQueryRecord)>;
+
+/// The BVH over the emissive triangles of `scene` (of `n` triangles in all) and their global
+/// indices, unless they are more than half of the scene (then it would save little).
+fn emitter_accel(
+    scene: &Scene,
+    mesh_emitter: &[Option<u32>],
+    n: usize,
+) -> Option<(Accel, Vec<u32>)> {
+    let mut global = Vec::new();
+    let mut first = 0u32;
+    for (m, e) in scene.meshes.iter().zip(mesh_emitter) {
+        let count = m.indices.len() as u32;
+        if e.is_some() {
+            global.extend(first..first + count);
+        }
+        first += count;
+    }
+    if global.len() * 2 > n {
+        return None;
+    }
+    let tris = scene
+        .meshes
+        .iter()
+        .zip(mesh_emitter)
+        .filter(|(_, e)| e.is_some())
+        .flat_map(|(m, _)| m.indices.iter().map(|t| t.map(|i| m.positions[i as usize])));
+    Some((Accel::build_from(global.len(), tris), global))
+}
+
 /// Per-path-sample state: the random stream and counters.
 pub struct Ctx {
     pub sampler: crate::sampler::SobolSampler,
@@ -46,6 +77,10 @@ pub struct Ctx {
 pub struct RenderScene {
     pub scene: Scene,
     accel: Accel,
+    /// A BVH over the emissive triangles alone, with each one's global triangle index: rays
+    /// whose only use is the emission they meet find it here first (see
+    /// [`RenderScene::emission_along`]). `None` when emissive triangles are most of the scene.
+    emitter_accel: Option<(Accel, Vec<u32>)>,
     /// Global triangle index → (mesh, triangle within the mesh).
     tri_map: Vec<(u32, u32)>,
     pub emitters: Vec<EmitterInstance>,
@@ -132,12 +167,14 @@ impl RenderScene {
                 radiance: scene.background,
             }));
         }
+        let emitter_accel = emitter_accel(&scene, &mesh_emitter, n);
         let powers: Vec<f32> = emitters.iter().map(|e| e.power(&scene, radius)).collect();
         let lights = LightSampler::new(&powers, choice);
         scene.warnings.extend(warnings);
         RenderScene {
             scene,
             accel,
+            emitter_accel,
             tri_map,
             emitters,
             mesh_emitter,
@@ -152,7 +189,50 @@ impl RenderScene {
     pub fn intersect(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Option<Intersection> {
         ctx.rays += 1;
         let hit = self.accel.intersect(o, d, 0.0, f32::INFINITY)?;
-        let (mi, ti) = self.tri_map[hit.triangle as usize];
+        Some(self.intersection(&hit, hit.triangle, d))
+    }
+
+    /// The radiance a ray from `o` along the unit direction `d` meets — the emission of the
+    /// first surface it hits, or the background if it escapes — when nothing else about that
+    /// surface is needed (the last segment of a path). Equal to [`RenderScene::emitted`] /
+    /// [`RenderScene::background_radiance`] after [`RenderScene::intersect`], but it looks for
+    /// the nearest *emissive* triangle in a small BVH first and then only asks whether anything
+    /// blocks the ray before it (an any-hit query); a ray that meets no emitter and no
+    /// background costs no scene traversal at all. Not for camera rays (hidden meshes).
+    #[inline]
+    pub fn emission_along(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Emitted {
+        let Some((emissive, global)) = &self.emitter_accel else {
+            return match self.intersect(ctx, o, d) {
+                Some(its) => self.emitted(&its, o),
+                None => self.background_radiance(d, o),
+            };
+        };
+        if let Some(hit) = emissive.intersect(o, d, 0.0, f32::INFINITY) {
+            let its = self.intersection(&hit, global[hit.triangle as usize], d);
+            let (e, le, rec) = self.emitted(&its, o)?;
+            if le == Vec3::ZERO {
+                return None;
+            }
+            // Only a nearer surface can block it (`t < hit.t` excludes the emitter itself:
+            // both BVHs hold the same triangle, intersected with the same arithmetic).
+            ctx.rays += 1;
+            if self.accel.occluded(o, d, 0.0, hit.t) {
+                return None;
+            }
+            return Some((e, le, rec));
+        }
+        self.background?;
+        ctx.rays += 1;
+        if self.accel.occluded(o, d, 0.0, f32::INFINITY) {
+            return None;
+        }
+        self.background_radiance(d, o)
+    }
+
+    /// The full intersection record of `hit` on global triangle `triangle`.
+    #[inline]
+    fn intersection(&self, hit: &Hit, triangle: u32, d: Vec3) -> Intersection {
+        let (mi, ti) = self.tri_map[triangle as usize];
         let mesh = &self.scene.meshes[mi as usize];
         let [i0, i1, i2] = mesh.indices[ti as usize].map(|i| i as usize);
         let (b1, b2) = (hit.u, hit.v);
@@ -182,7 +262,7 @@ impl RenderScene {
         } else {
             mesh.uvs[i0] * b0 + mesh.uvs[i1] * b1 + mesh.uvs[i2] * b2
         };
-        Some(Intersection {
+        Intersection {
             t: hit.t,
             p,
             ng,
@@ -191,7 +271,7 @@ impl RenderScene {
             mesh: mi,
             material: mesh.material as u32,
             emitter: self.mesh_emitter[mi as usize],
-        })
+        }
     }
 
     /// Like [`RenderScene::intersect`] for the ray leaving path vertex `depth - 1`; camera rays
@@ -262,11 +342,7 @@ impl RenderScene {
     /// Radiance emitted by the hit surface towards `from` (the ray's origin), with the
     /// emitter's index for MIS.
     #[inline]
-    pub fn emitted(
-        &self,
-        its: &Intersection,
-        from: Vec3,
-    ) -> Option<(u32, Vec3, EmitterQueryRecord)> {
+    pub fn emitted(&self, its: &Intersection, from: Vec3) -> Emitted {
         let e = its.emitter?;
         let rec = EmitterQueryRecord::between(from, its.p, its.ns, its.ng, its.uv);
         let le = self.emitters[e as usize].eval(&self.scene, &rec);
@@ -275,11 +351,7 @@ impl RenderScene {
 
     /// Background radiance for a ray leaving the scene along `d` from `from`.
     #[inline]
-    pub fn background_radiance(
-        &self,
-        d: Vec3,
-        from: Vec3,
-    ) -> Option<(u32, Vec3, EmitterQueryRecord)> {
+    pub fn background_radiance(&self, d: Vec3, from: Vec3) -> Emitted {
         let b = self.background?;
         let rec = EmitterQueryRecord::towards(from, d);
         Some((b, self.emitters[b as usize].eval(&self.scene, &rec), rec))
@@ -318,5 +390,81 @@ impl RenderScene {
 
     pub fn triangle_count(&self) -> usize {
         self.tri_map.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampler::{Sampler, SobolSampler};
+    use crate::sampling::square_to_uniform_sphere;
+    use crate::scene::builtin;
+
+    /// `emission_along` must return what a full closest-hit trace returns, for rays that hit
+    /// the light, rays blocked before it (by the spheres), rays that escape to the background
+    /// and rays that hit nothing emissive; with and without a background.
+    #[test]
+    fn emission_along_equals_a_full_trace() {
+        for background in [Vec3::ZERO, Vec3::new(0.2, 0.3, 0.4)] {
+            let mut scene = builtin::by_name("cornell-spheres").unwrap();
+            scene.background = background;
+            // A ball hanging just under the light blocks rays right before they reach it.
+            let m = scene.meshes[0].material;
+            let ball = builtin::sphere("ball", m, Vec3::new(0.05, 0.85, 0.0), 0.08, 16, 32);
+            scene.meshes.push(ball);
+            let rs = RenderScene::new(scene, LightChoice::Power);
+            assert!(rs.emitter_accel.is_some());
+            let (lo, hi) = rs.scene.bounds().unwrap();
+            let mut rng = Sampler::new(7, 0, 0);
+            let mut ctx = Ctx {
+                sampler: SobolSampler::new(0, 0, 0),
+                rays: 0,
+            };
+            let (mut lit, mut blocked, mut escaped) = (0, 0, 0);
+            for _ in 0..400_000 {
+                let u = Vec3::new(rng.next_1d(), rng.next_1d(), rng.next_1d());
+                // Origins inside (and a little outside) the box, all directions.
+                let o = lo - (hi - lo) * 0.05 + (hi - lo) * 1.1 * u;
+                let d = square_to_uniform_sphere(rng.next_2d());
+                let fast = rs.emission_along(&mut ctx, o, d);
+                let full = match rs.intersect(&mut ctx, o, d) {
+                    Some(its) => rs.emitted(&its, o),
+                    None => rs.background_radiance(d, o),
+                };
+                let full = full.filter(|(_, le, _)| *le != Vec3::ZERO);
+                match (&fast, &full) {
+                    (Some((a, la, ra)), Some((b, lb, rb))) => {
+                        assert_eq!(a, b);
+                        assert_eq!(la, lb, "radiance along {o} {d}");
+                        assert_eq!(ra.pdf, rb.pdf);
+                        assert_eq!(ra.p, rb.p);
+                        if rs.background == Some(*a) {
+                            escaped += 1;
+                        } else {
+                            lit += 1;
+                        }
+                    }
+                    (None, None) => {
+                        if rs
+                            .emitter_accel
+                            .as_ref()
+                            .unwrap()
+                            .0
+                            .intersect(o, d, 0.0, f32::INFINITY)
+                            .is_some()
+                        {
+                            blocked += 1;
+                        }
+                    }
+                    _ => panic!("ray {o} {d}: fast {fast:?}, full {full:?}"),
+                }
+            }
+            assert!(lit > 2000 && blocked > 500, "lit {lit}, blocked {blocked}");
+            assert_eq!(
+                escaped > 1000,
+                background != Vec3::ZERO,
+                "escaped {escaped}"
+            );
+        }
     }
 }

@@ -16,7 +16,7 @@ impl Integrator for DirectEms {
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
         loop {
-            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth);
+            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth, depth >= self.max_depth);
             if let Some((_, le, _)) = emitted {
                 l += throughput * le;
             }

@@ -16,7 +16,7 @@ impl Integrator for DirectMats {
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
         loop {
-            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth);
+            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth, depth >= self.max_depth);
             if let Some((_, le, _)) = emitted {
                 l += throughput * le;
             }
@@ -36,7 +36,7 @@ impl Integrator for DirectMats {
             depth += 1;
             if rec.measure != Measure::Discrete {
                 // The one non-delta bounce: count what it sees, then stop.
-                if let (_, Some((_, le, _))) = trace_emitted(scene, ctx, o, d, depth) {
+                if let (_, Some((_, le, _))) = trace_emitted(scene, ctx, o, d, depth, true) {
                     l += throughput * le;
                 }
                 return l;

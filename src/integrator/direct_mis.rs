@@ -18,7 +18,7 @@ impl Integrator for DirectMis {
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
         loop {
-            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth);
+            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth, depth >= self.max_depth);
             if let Some((_, le, _)) = emitted {
                 l += throughput * le;
             }
@@ -41,7 +41,7 @@ impl Integrator for DirectMis {
             depth += 1;
             if rec.measure != Measure::Discrete {
                 // The BSDF half of MIS at this vertex, then stop.
-                if let (_, Some((e, le, erec))) = trace_emitted(scene, ctx, o, d, depth) {
+                if let (_, Some((e, le, erec))) = trace_emitted(scene, ctx, o, d, depth, true) {
                     l += throughput * le * mis_weight(rec.pdf, scene.light_pdf(e, &erec));
                 }
                 return l;

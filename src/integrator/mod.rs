@@ -13,9 +13,8 @@ pub mod path;
 
 use crate::accel::offset_origin;
 use crate::bsdf::{self, Bsdf, BsdfInstance, BsdfQueryRecord};
-use crate::emitter::EmitterQueryRecord;
 use crate::frame::Frame;
-use crate::render_scene::{Ctx, Intersection, RenderScene};
+use crate::render_scene::{Ctx, Emitted, Intersection, RenderScene};
 use glam::Vec3;
 
 /// One integrator: radiance along the unit-direction ray `o + t d`.
@@ -166,12 +165,11 @@ pub fn sample_emitter(
     f * weight * w
 }
 
-/// Emitted radiance met by a ray: `(emitter index, radiance, record for MIS)`.
-pub type Emitted = Option<(u32, Vec3, EmitterQueryRecord)>;
-
 /// Traces the ray leaving path vertex `depth - 1` and returns the surface it hits (if any) with
 /// the radiance arriving along it from that surface's emission, or from the background when
-/// the ray escapes.
+/// the ray escapes. When `last` (the path ends at the hit: only the emission matters) the
+/// surface is not returned and the emission is found the cheap way
+/// ([`RenderScene::emission_along`]).
 #[inline]
 pub fn trace_emitted(
     scene: &RenderScene,
@@ -179,7 +177,11 @@ pub fn trace_emitted(
     o: Vec3,
     d: Vec3,
     depth: u32,
+    last: bool,
 ) -> (Option<Intersection>, Emitted) {
+    if last && depth > 1 {
+        return (None, scene.emission_along(ctx, o, d));
+    }
     let hit = scene.trace(ctx, o, d, depth);
     let emitted = match &hit {
         Some(its) => scene.emitted(its, o),

@@ -38,7 +38,7 @@ impl Integrator for PathMats {
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
         loop {
-            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth);
+            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth, depth >= self.max_depth);
             if let Some((_, le, _)) = emitted {
                 l += throughput * le;
             }
@@ -69,7 +69,7 @@ impl Integrator for PathMis {
         // and delta samples (emitter sampling could not have produced them: MIS weight 1).
         let mut bsdf_pdf = f32::INFINITY;
         loop {
-            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth);
+            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth, depth >= self.max_depth);
             if let Some((e, le, erec)) = emitted {
                 let w = if bsdf_pdf.is_infinite() {
                     1.0
