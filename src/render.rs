@@ -4,7 +4,7 @@
 
 use crate::camera::RayCamera;
 use crate::integrator::{self, Integrator};
-use crate::render_scene::{Ctx, RenderScene};
+use crate::render_scene::{Ctx, RayQuery, RenderScene};
 use crate::sampler::SobolSampler;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -139,7 +139,8 @@ pub fn validate(opts: &RenderOptions) -> Result<(), RenderError> {
     Ok(())
 }
 
-/// Renders one pixel's samples; returns the mean radiance of the accepted samples.
+/// Renders one pixel's samples; returns the mean radiance of the accepted samples. With `log`,
+/// every scene-BVH query is appended to it.
 #[inline]
 #[allow(clippy::too_many_arguments)]
 fn render_pixel(
@@ -151,6 +152,7 @@ fn render_pixel(
     py: u32,
     rays: &mut u64,
     rejected: &mut u64,
+    log: &mut Option<Vec<RayQuery>>,
 ) -> [f32; 4] {
     let pixel_index = py as u64 * opts.width as u64 + px as u64;
     let mut sum = Vec3::ZERO;
@@ -159,11 +161,13 @@ fn render_pixel(
         let mut ctx = Ctx {
             sampler: SobolSampler::new(opts.seed, pixel_index, s as u64),
             rays: 0,
+            log: log.take(),
         };
         let film = Vec2::new(px as f32, py as f32) + ctx.sampler.next_2d();
         let (o, d) = camera.ray(film);
         let l = integrator.li(scene, &mut ctx, o, d);
         *rays += ctx.rays;
+        *log = ctx.log;
         if l.is_finite() && l.min_element() >= 0.0 {
             sum += l;
             accepted += 1;
@@ -177,6 +181,37 @@ fn render_pixel(
         Vec3::ZERO
     };
     [c.x, c.y, c.z, 1.0]
+}
+
+/// The scene-BVH queries a render with `opts` makes, in pixel order on one thread (for the
+/// traversal benchmark: `benches/traversal.rs`).
+pub fn record_rays(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+) -> Result<Vec<RayQuery>, RenderError> {
+    validate(opts)?;
+    let integrator = integrator::by_name(&opts.integrator, opts.max_depth.max(1))
+        .ok_or_else(|| RenderError::Invalid("unknown integrator".into()))?;
+    let camera = RayCamera::new(&scene.scene, opts.width, opts.height);
+    let [rx, ry, rw, rh] = opts.region.unwrap_or([0, 0, opts.width, opts.height]);
+    let mut log = Some(Vec::new());
+    let (mut rays, mut rejected) = (0, 0);
+    for y in ry..ry + rh {
+        for x in rx..rx + rw {
+            render_pixel(
+                scene,
+                &camera,
+                integrator.as_ref(),
+                opts,
+                x,
+                y,
+                &mut rays,
+                &mut rejected,
+                &mut log,
+            );
+        }
+    }
+    Ok(log.unwrap_or_default())
 }
 
 /// Renders the image. `on_tile(tile, tiles_done, tiles_total)` runs on a worker thread as each
@@ -215,6 +250,7 @@ pub fn render(
             .map(|&(tx, ty, tw, th)| {
                 let mut pixels = Vec::with_capacity((tw * th) as usize);
                 let (mut r, mut rej) = (0u64, 0u64);
+                let mut log = None;
                 for y in 0..th {
                     if cancel.load(Ordering::Relaxed) {
                         return Err(RenderError::Cancelled);
@@ -229,6 +265,7 @@ pub fn render(
                             ry + ty + y,
                             &mut r,
                             &mut rej,
+                            &mut log,
                         ));
                     }
                 }

@@ -67,11 +67,47 @@ fn emitter_accel(
     Some((Accel::build_from(global.len(), tris), global))
 }
 
+/// What a recorded ray asks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayKind {
+    /// The closest hit (camera and bounce rays).
+    Closest,
+    /// Whether anything lies on the segment (shadow rays).
+    Any,
+    /// The emission met by the last segment of a path: a plain renderer finds it with a
+    /// closest-hit query; Tesela with [`RenderScene::emission_along`].
+    Emission,
+}
+
+/// One ray cast by an integrator, as recorded for the traversal benchmark.
+#[derive(Clone, Copy, Debug)]
+pub struct RayQuery {
+    pub o: Vec3,
+    /// Unit direction.
+    pub d: Vec3,
+    /// The query covers `t` in `(0, tmax)`.
+    pub tmax: f32,
+    pub kind: RayKind,
+}
+
 /// Per-path-sample state: the random stream and counters.
 pub struct Ctx {
     pub sampler: crate::sampler::SobolSampler,
     /// Rays traced (camera, bounce and shadow rays).
     pub rays: u64,
+    /// When set, every ray cast is appended (`benches/traversal.rs` replays them).
+    pub log: Option<Vec<RayQuery>>,
+}
+
+impl Ctx {
+    /// Counts a ray and records it if recording.
+    #[inline(always)]
+    fn cast(&mut self, o: Vec3, d: Vec3, tmax: f32, kind: RayKind) {
+        self.rays += 1;
+        if let Some(log) = &mut self.log {
+            log.push(RayQuery { o, d, tmax, kind });
+        }
+    }
 }
 
 pub struct RenderScene {
@@ -187,7 +223,7 @@ impl RenderScene {
     /// Closest surface along the unit direction `d` from `o`.
     #[inline]
     pub fn intersect(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Option<Intersection> {
-        ctx.rays += 1;
+        ctx.cast(o, d, f32::INFINITY, RayKind::Closest);
         let hit = self.accel.intersect(o, d, 0.0, f32::INFINITY)?;
         Some(self.intersection(&hit, hit.triangle, d))
     }
@@ -207,6 +243,7 @@ impl RenderScene {
                 None => self.background_radiance(d, o),
             };
         };
+        ctx.cast(o, d, f32::INFINITY, RayKind::Emission);
         if let Some(hit) = emissive.intersect(o, d, 0.0, f32::INFINITY) {
             let its = self.intersection(&hit, global[hit.triangle as usize], d);
             let (e, le, rec) = self.emitted(&its, o)?;
@@ -215,14 +252,12 @@ impl RenderScene {
             }
             // Only a nearer surface can block it (`t < hit.t` excludes the emitter itself:
             // both BVHs hold the same triangle, intersected with the same arithmetic).
-            ctx.rays += 1;
             if self.accel.occluded(o, d, 0.0, hit.t) {
                 return None;
             }
             return Some((e, le, rec));
         }
         self.background?;
-        ctx.rays += 1;
         if self.accel.occluded(o, d, 0.0, f32::INFINITY) {
             return None;
         }
@@ -295,7 +330,6 @@ impl RenderScene {
     /// to the emitter sample `rec` (a point, or a direction at infinity).
     #[inline]
     pub fn unoccluded(&self, ctx: &mut Ctx, p: Vec3, ng: Vec3, rec: &EmitterQueryRecord) -> bool {
-        ctx.rays += 1;
         let o = offset_origin(p, ng, rec.wi);
         if rec.dist.is_finite() {
             // Aim at the light point moved off its own surface, and stop just short of it.
@@ -305,8 +339,11 @@ impl RenderScene {
             if dist <= 0.0 || !dist.is_finite() {
                 return true;
             }
-            !self.accel.occluded(o, d / dist, 0.0, dist * (1.0 - 1e-6))
+            let (d, tmax) = (d / dist, dist * (1.0 - 1e-6));
+            ctx.cast(o, d, tmax, RayKind::Any);
+            !self.accel.occluded(o, d, 0.0, tmax)
         } else {
+            ctx.cast(o, rec.wi, f32::INFINITY, RayKind::Any);
             !self.accel.occluded(o, rec.wi, 0.0, f32::INFINITY)
         }
     }
@@ -388,6 +425,11 @@ impl RenderScene {
         self.emitters[i as usize].is_delta()
     }
 
+    /// The BVH over every triangle.
+    pub fn accel(&self) -> &Accel {
+        &self.accel
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.tri_map.len()
     }
@@ -419,6 +461,7 @@ mod tests {
             let mut ctx = Ctx {
                 sampler: SobolSampler::new(0, 0, 0),
                 rays: 0,
+                log: None,
             };
             let (mut lit, mut blocked, mut escaped) = (0, 0, 0);
             for _ in 0..400_000 {
