@@ -446,7 +446,7 @@ def tables(result, setup):
     return "\n".join(out)
 
 
-def targets(results):
+def targets(results, traversal_results=()):
     """The issue's ratio targets, from the medians."""
     med = lambda res, peer, key: (statistics.median(r[key] for r in res["runs"][peer])  # noqa
                                   if peer in res["runs"] else None)
@@ -473,7 +473,27 @@ def targets(results):
             row(res, "equal-time relMSE ≤ ½ Cycles' (ratio)", e / c if c else None, 0.5, "low")
         one = med(res, "tesela-1t", "sps")
         row(res, "2 threads ≥ 1.8× one thread (ratio)", t / one if one else None, 1.8)
+        if res["triangles"] >= 1_000_000:
+            row(res, "BVH build of ≥ 1M triangles ≤ 1 s (s)", med(res, "tesela", "setup_s"), 1.0,
+                "low")
+    for tr in traversal_results:
+        row(tr, "renderer rays/s ≥ 70% of raw obvhs, same rays (ratio)", tr["renderer_vs_raw"], 0.7)
     return "\n".join(lines)
+
+
+def traversal(gltf, size, mode):
+    """``cargo bench --bench traversal`` on the scene: the renderer's rays/s against raw obvhs
+    CWBVH traversal of the same rays (one thread). Returns its report and the ratio."""
+    integrator, depth = MODES[mode]["tesela"]
+    cmd = ["cargo", "bench", "-q", "--bench", "traversal", "--", str(gltf), "--size", str(size),
+           "--spp", "4", "--integrator", integrator, "--max-depth", str(depth)]
+    p = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True)
+    if p.returncode != 0:
+        raise RuntimeError(f"traversal bench failed: {' '.join(cmd)}\n{p.stderr[-2000:]}")
+    text = p.stdout.strip()
+    m = re.search(r"renderer \(whole render, every ray cast\)\s+[\d.]+ M rays/s\s+([\d.]+)x", text)
+    return {"scene": Path(gltf).stem, "mode": mode, "report": text,
+            "renderer_vs_raw": float(m.group(1)) if m else None}
 
 
 def merge(args):
@@ -546,6 +566,8 @@ def main():
                     help="reference spp = this x budget spp (default 16; quick 8)")
     ap.add_argument("--cal-spp", type=int, default=None)
     ap.add_argument("--tesela", default=str(REPO / "target/release/tesela"))
+    ap.add_argument("--no-traversal", action="store_true",
+                    help="skip the raw-obvhs comparison (cargo bench --bench traversal)")
     ap.add_argument("--out", default=None, help="directory for the .md/.json result "
                     "(default bench/results; quick: a temporary directory)")
     ap.add_argument("--merge", nargs="+", metavar="JSON",
@@ -640,8 +662,20 @@ def main():
             t = tables(res, setup)
             md.append(t)
             log("\n" + t + "\n")
+    traversal_results = []
+    if not args.no_traversal and any(p.name == "tesela" for p in peers):
+        for res in results:
+            if res["triangles"] < 1_000_000 and not q:
+                continue
+            gltf = work / f"{res['scene']}.gltf"
+            log(f"\n## traversal: {res['scene']} {res['mode']} (cargo bench --bench traversal)")
+            tr = traversal(gltf, size, res["mode"])
+            log(tr["report"])
+            traversal_results.append(tr)
+            md.append(f"#### {res['scene']} — {res['mode']}: Tesela's rays against raw obvhs "
+                      f"(`cargo bench --bench traversal`, one thread)\n\n```\n{tr['report']}\n```")
     env["load_avg_end"] = os.getloadavg()
-    tgt = targets(results)
+    tgt = targets(results, traversal_results)
     log("\n### Targets (issue 5; ratios of medians)\n\n" + tgt)
     outdir = Path(args.out) if args.out else (work if q else HERE / "results")
     outdir.mkdir(parents=True, exist_ok=True)

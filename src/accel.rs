@@ -30,20 +30,27 @@ struct PackedTriangle {
 pub struct Hit {
     /// Ray parameter of the hit (distance for a unit direction).
     pub t: f32,
-    /// Index of the triangle in the order it was given to [`Accel::build`].
-    pub triangle: u32,
+    /// The key the triangle was given to [`Accel::build_from`] with (for a scene: mesh index,
+    /// triangle index within the mesh).
+    pub key: [u32; 2],
     /// Barycentric weight of vertex 1.
     pub u: f32,
     /// Barycentric weight of vertex 2 (vertex 0 has `1 - u - v`).
     pub v: f32,
+    /// The hit point `v0 + u e1 + v e2` (world space), from the triangle data the test just
+    /// read (no second look-up of the vertices).
+    pub p: Vec3,
+    /// `e1 × e2`: the unnormalised geometric normal by the right-hand rule (zero for a
+    /// degenerate triangle).
+    pub ng: Vec3,
 }
 
 /// A BVH over triangles.
 pub struct Accel {
     bvh: CwBvh,
     tris: Vec<PackedTriangle>,
-    /// For each stored triangle, its index in the input order.
-    ids: Vec<u32>,
+    /// For each stored triangle (BVH leaf order), its key.
+    keys: Vec<[u32; 2]>,
 }
 
 /// Möller–Trumbore: `(t, u, v)` of the hit inside `(tmin, tmax)`, else `None`.
@@ -76,14 +83,21 @@ fn intersect_triangle(
 }
 
 impl Accel {
-    /// Builds the BVH over `triangles` (world-space vertex triples).
+    /// Builds the BVH over `triangles` (world-space vertex triples); triangle `i` has the
+    /// key `[0, i]`.
     pub fn build(triangles: &[[Vec3; 3]]) -> Accel {
-        Accel::build_from(triangles.len(), triangles.iter().copied())
+        let keys = (0..triangles.len() as u32).map(|i| [0, i]);
+        Accel::build_from(triangles.len(), triangles.iter().copied(), keys)
     }
 
-    /// Builds the BVH over the `n` triangles of `triangles` without an intermediate copy
-    /// of the scene (a 10-million-triangle scene saves 360 MB at the build's peak).
-    pub fn build_from(n: usize, triangles: impl Iterator<Item = [Vec3; 3]>) -> Accel {
+    /// Builds the BVH over the `n` triangles of `triangles`, each with the matching item of
+    /// `keys` (returned in [`Hit::key`]), without an intermediate copy of the scene (a
+    /// 10-million-triangle scene saves 360 MB at the build's peak).
+    pub fn build_from(
+        n: usize,
+        triangles: impl Iterator<Item = [Vec3; 3]>,
+        keys: impl Iterator<Item = [u32; 2]>,
+    ) -> Accel {
         let mut input: Vec<Triangle> = Vec::with_capacity(n);
         input.extend(triangles.map(|t| {
             let inside = t.iter().all(|v| v.abs().max_element() <= MAX_COORD);
@@ -98,13 +112,13 @@ impl Accel {
             return Accel {
                 bvh: CwBvh::default(),
                 tris: Vec::new(),
-                ids: Vec::new(),
+                keys: Vec::new(),
             };
         }
         let mut build_time = Duration::ZERO;
         let bvh = build_cwbvh_from_tris(&input, BvhBuildParams::medium_build(), &mut build_time);
-        let ids = bvh.primitive_indices.clone();
-        let tris = ids
+        let tris = bvh
+            .primitive_indices
             .iter()
             .map(|&i| {
                 let t = &input[i as usize];
@@ -115,7 +129,14 @@ impl Accel {
                 }
             })
             .collect();
-        Accel { bvh, tris, ids }
+        drop(input);
+        let input_keys: Vec<[u32; 2]> = keys.take(n).collect();
+        let keys = bvh
+            .primitive_indices
+            .iter()
+            .map(|&i| input_keys.get(i as usize).copied().unwrap_or([u32::MAX; 2]))
+            .collect();
+        Accel { bvh, tris, keys }
     }
 
     /// Closest hit of the ray `o + t d` with `t` in `(tmin, tmax)`.
@@ -138,11 +159,16 @@ impl Accel {
                 None => f32::INFINITY,
             }
         });
-        found.then(|| Hit {
-            t: hit.t,
-            triangle: self.ids[hit.primitive_id as usize],
-            u: bu,
-            v: bv,
+        found.then(|| {
+            let tri = &self.tris[hit.primitive_id as usize];
+            Hit {
+                t: hit.t,
+                key: self.keys[hit.primitive_id as usize],
+                u: bu,
+                v: bv,
+                p: (tri.v0 + tri.e1 * bu + tri.e2 * bv).into(),
+                ng: tri.e1.cross(tri.e2).into(),
+            }
         })
     }
 
@@ -201,7 +227,7 @@ mod tests {
             .intersect(Vec3::new(0.2, 0.3, 5.0), -Vec3::Z, 0.0, f32::INFINITY)
             .unwrap();
         assert!((h.t - 5.0).abs() < 1e-5);
-        assert!(h.triangle < 2, "nearest quad is the first one");
+        assert!(h.key[1] < 2, "nearest quad is the first one");
         assert!(accel.occluded(Vec3::new(0.2, 0.3, 5.0), -Vec3::Z, 0.0, 6.0));
         assert!(!accel.occluded(Vec3::new(0.2, 0.3, 5.0), -Vec3::Z, 0.0, 4.9));
         assert!(
@@ -255,7 +281,7 @@ mod tests {
         let h = accel
             .intersect(Vec3::new(0.5, 0.5, 1.0), -Vec3::Z, 0.0, f32::INFINITY)
             .unwrap();
-        assert!(h.triangle < 2 && (h.t - 1.0).abs() < 1e-6);
+        assert!(h.key[1] < 2 && (h.t - 1.0).abs() < 1e-6);
         assert!(
             accel
                 .intersect(Vec3::new(5.0, 5.0, 1.0), -Vec3::Z, 0.0, f32::INFINITY)
@@ -271,5 +297,8 @@ mod tests {
             .intersect(Vec3::new(0.25, 0.5, 1.0), -Vec3::Z, 0.0, 10.0)
             .unwrap();
         assert!((h.u - 0.25).abs() < 1e-6 && (h.v - 0.5).abs() < 1e-6);
+        assert!((h.p - Vec3::new(0.25, 0.5, 0.0)).length() < 1e-6);
+        assert_eq!(h.ng, Vec3::Z);
+        assert_eq!(h.key, [0, 0]);
     }
 }

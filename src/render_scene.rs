@@ -39,32 +39,36 @@ impl Intersection {
 /// Emitted radiance met by a ray: `(emitter index, radiance, record for MIS)`.
 pub type Emitted = Option<(u32, Vec3, EmitterQueryRecord)>;
 
-/// The BVH over the emissive triangles of `scene` (of `n` triangles in all) and their global
-/// indices, unless they are more than half of the scene (then it would save little).
-fn emitter_accel(
-    scene: &Scene,
-    mesh_emitter: &[Option<u32>],
-    n: usize,
-) -> Option<(Accel, Vec<u32>)> {
-    let mut global = Vec::new();
-    let mut first = 0u32;
-    for (m, e) in scene.meshes.iter().zip(mesh_emitter) {
-        let count = m.indices.len() as u32;
-        if e.is_some() {
-            global.extend(first..first + count);
-        }
-        first += count;
-    }
-    if global.len() * 2 > n {
-        return None;
-    }
-    let tris = scene
-        .meshes
-        .iter()
-        .zip(mesh_emitter)
-        .filter(|(_, e)| e.is_some())
-        .flat_map(|(m, _)| m.indices.iter().map(|t| t.map(|i| m.positions[i as usize])));
-    Some((Accel::build_from(global.len(), tris), global))
+/// Every triangle of the meshes for which `keep(mesh index)` holds, with its key
+/// `[mesh index, triangle index]`, for [`Accel::build_from`].
+fn mesh_triangles<'a>(
+    scene: &'a Scene,
+    keep: impl Fn(usize) -> bool + Copy + 'a,
+) -> (
+    usize,
+    impl Iterator<Item = [Vec3; 3]> + 'a,
+    impl Iterator<Item = [u32; 2]> + 'a,
+) {
+    let meshes = || {
+        scene
+            .meshes
+            .iter()
+            .enumerate()
+            .filter(move |(i, _)| keep(*i))
+    };
+    let n = meshes().map(|(_, m)| m.indices.len()).sum();
+    let tris =
+        meshes().flat_map(|(_, m)| m.indices.iter().map(|t| t.map(|i| m.positions[i as usize])));
+    let keys =
+        meshes().flat_map(|(mi, m)| (0..m.indices.len() as u32).map(move |ti| [mi as u32, ti]));
+    (n, tris, keys)
+}
+
+/// The BVH over the emissive triangles of `scene` (of `n` triangles in all), unless they are
+/// more than half of the scene (then it would save little).
+fn emitter_accel(scene: &Scene, mesh_emitter: &[Option<u32>], n: usize) -> Option<Accel> {
+    let (count, tris, keys) = mesh_triangles(scene, |i| mesh_emitter[i].is_some());
+    (count * 2 <= n).then(|| Accel::build_from(count, tris, keys))
 }
 
 /// What a recorded ray asks.
@@ -113,12 +117,10 @@ impl Ctx {
 pub struct RenderScene {
     pub scene: Scene,
     accel: Accel,
-    /// A BVH over the emissive triangles alone, with each one's global triangle index: rays
-    /// whose only use is the emission they meet find it here first (see
-    /// [`RenderScene::emission_along`]). `None` when emissive triangles are most of the scene.
-    emitter_accel: Option<(Accel, Vec<u32>)>,
-    /// Global triangle index → (mesh, triangle within the mesh).
-    tri_map: Vec<(u32, u32)>,
+    /// A BVH over the emissive triangles alone: rays whose only use is the emission they meet
+    /// find it here first (see [`RenderScene::emission_along`]). `None` when emissive
+    /// triangles are most of the scene.
+    emitter_accel: Option<Accel>,
     pub emitters: Vec<EmitterInstance>,
     /// Mesh index → its area emitter.
     mesh_emitter: Vec<Option<u32>>,
@@ -127,25 +129,17 @@ pub struct RenderScene {
     pub lights: LightSampler,
     /// Radius of the scene's bounding sphere.
     pub radius: f32,
+    /// Number of triangles.
+    triangles: usize,
 }
 
 impl RenderScene {
     /// Builds the BVH and the emitters. Emissive meshes of zero area are skipped with a warning.
     pub fn new(mut scene: Scene, choice: LightChoice) -> RenderScene {
-        let n = scene.triangle_count();
-        // Triangles go straight from the meshes into the builder, and the map is made after
-        // the build: neither adds to the build's peak memory.
-        let accel = Accel::build_from(
-            n,
-            scene
-                .meshes
-                .iter()
-                .flat_map(|m| m.indices.iter().map(|t| t.map(|i| m.positions[i as usize]))),
-        );
-        let mut tri_map = Vec::with_capacity(n);
-        for (mi, m) in scene.meshes.iter().enumerate() {
-            tri_map.extend((0..m.indices.len() as u32).map(|ti| (mi as u32, ti)));
-        }
+        // Triangles go straight from the meshes into the builder: no copy of the scene at the
+        // build's peak memory.
+        let (n, tris, keys) = mesh_triangles(&scene, |_| true);
+        let accel = Accel::build_from(n, tris, keys);
         let radius = match scene.bounds() {
             Some((lo, hi)) => ((hi - lo) * 0.5).length().max(1e-3),
             None => 1.0,
@@ -211,7 +205,7 @@ impl RenderScene {
             scene,
             accel,
             emitter_accel,
-            tri_map,
+            triangles: n,
             emitters,
             mesh_emitter,
             background,
@@ -225,7 +219,7 @@ impl RenderScene {
     pub fn intersect(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Option<Intersection> {
         ctx.cast(o, d, f32::INFINITY, RayKind::Closest);
         let hit = self.accel.intersect(o, d, 0.0, f32::INFINITY)?;
-        Some(self.intersection(&hit, hit.triangle, d))
+        Some(self.intersection(&hit, d))
     }
 
     /// The radiance a ray from `o` along the unit direction `d` meets — the emission of the
@@ -237,7 +231,7 @@ impl RenderScene {
     /// background costs no scene traversal at all. Not for camera rays (hidden meshes).
     #[inline]
     pub fn emission_along(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Emitted {
-        let Some((emissive, global)) = &self.emitter_accel else {
+        let Some(emissive) = &self.emitter_accel else {
             return match self.intersect(ctx, o, d) {
                 Some(its) => self.emitted(&its, o),
                 None => self.background_radiance(d, o),
@@ -245,7 +239,7 @@ impl RenderScene {
         };
         ctx.cast(o, d, f32::INFINITY, RayKind::Emission);
         if let Some(hit) = emissive.intersect(o, d, 0.0, f32::INFINITY) {
-            let its = self.intersection(&hit, global[hit.triangle as usize], d);
+            let its = self.intersection(&hit, d);
             let (e, le, rec) = self.emitted(&its, o)?;
             if le == Vec3::ZERO {
                 return None;
@@ -264,25 +258,25 @@ impl RenderScene {
         self.background_radiance(d, o)
     }
 
-    /// The full intersection record of `hit` on global triangle `triangle`.
+    /// The full intersection record of `hit` (a hit of a ray along `d`).
     #[inline]
-    fn intersection(&self, hit: &Hit, triangle: u32, d: Vec3) -> Intersection {
-        let (mi, ti) = self.tri_map[triangle as usize];
+    fn intersection(&self, hit: &Hit, d: Vec3) -> Intersection {
+        let [mi, ti] = hit.key;
         let mesh = &self.scene.meshes[mi as usize];
-        let [i0, i1, i2] = mesh.indices[ti as usize].map(|i| i as usize);
         let (b1, b2) = (hit.u, hit.v);
         let b0 = 1.0 - b1 - b2;
-        let (p0, p1, p2) = (mesh.positions[i0], mesh.positions[i1], mesh.positions[i2]);
-        let p = p0 * b0 + p1 * b1 + p2 * b2;
-        let cross = (p1 - p0).cross(p2 - p0);
-        let len = cross.length();
+        let len = hit.ng.length();
         let mut ng = if len > 0.0 && len.is_finite() {
-            cross / len
+            hit.ng / len
         } else {
             -d
         };
+        // Vertex attributes only when the mesh has them (position and geometric normal come
+        // with the hit).
+        let corners = || mesh.indices[ti as usize].map(|i| i as usize);
         let mut ns = ng;
         if !mesh.normals.is_empty() {
+            let [i0, i1, i2] = corners();
             let s = mesh.normals[i0] * b0 + mesh.normals[i1] * b1 + mesh.normals[i2] * b2;
             let l = s.length();
             if l > 1e-12 && l.is_finite() {
@@ -295,11 +289,12 @@ impl RenderScene {
         let uv = if mesh.uvs.is_empty() {
             Vec2::ZERO
         } else {
+            let [i0, i1, i2] = corners();
             mesh.uvs[i0] * b0 + mesh.uvs[i1] * b1 + mesh.uvs[i2] * b2
         };
         Intersection {
             t: hit.t,
-            p,
+            p: hit.p,
             ng,
             ns,
             uv,
@@ -431,7 +426,7 @@ impl RenderScene {
     }
 
     pub fn triangle_count(&self) -> usize {
-        self.tri_map.len()
+        self.triangles
     }
 }
 
@@ -492,7 +487,6 @@ mod tests {
                             .emitter_accel
                             .as_ref()
                             .unwrap()
-                            .0
                             .intersect(o, d, 0.0, f32::INFINITY)
                             .is_some()
                         {

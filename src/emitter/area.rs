@@ -85,8 +85,11 @@ impl AreaEmitter {
     pub fn choose_triangle(&self, u: Vec2) -> (usize, f32, f32) {
         let t = u.x as f64 + u.y as f64 * (1.0 / 16_777_216.0);
         let (tri, r) = self.cdf.sample_fine(t);
-        let bits = (48.0 + self.cdf.pmf_fine(tri).log2()).max(2.0);
-        let scale = (bits * 0.5).floor().clamp(1.0, 24.0).exp2();
+        // 2^⌊bits/2⌋ for the `bits = 48 + ⌊log2 pmf⌋` bits of `t` the triangle's interval
+        // spans, from the exponent field of the (positive, normal) double `pmf`.
+        let log2_pmf = ((self.cdf.pmf_fine(tri).to_bits() >> 52) & 0x7ff) as i64 - 1023;
+        let bits = (48 + log2_pmf).max(2);
+        let scale = (1u32 << (bits / 2).clamp(1, 24)) as f64;
         const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
         (
             tri,
