@@ -190,6 +190,9 @@ impl DiscreteCdf {
     #[inline]
     pub fn sample_fine(&self, u: f64) -> (usize, f64) {
         let n = self.len();
+        if n == 1 {
+            return (0, u.clamp(0.0, 1.0 - f64::EPSILON));
+        }
         let mut i = self.cdf64[1..].partition_point(|&c| c <= u).min(n - 1);
         while self.pmf_fine(i) <= 0.0 && i > 0 {
             i -= 1;
