@@ -17,6 +17,10 @@ use std::time::Duration;
 /// empty one that no ray hits.
 pub const MAX_COORD: f32 = 1e12;
 
+/// Up to this many triangles a ray tests each one instead of traversing the BVH (an area
+/// light's few triangles in the emitter BVH, tiny scenes).
+const BRUTE_FORCE: usize = 8;
+
 /// A triangle prepared for intersection: `v0` and the edges `e1 = v1 - v0`, `e2 = v2 - v0`.
 #[derive(Clone, Copy, Debug)]
 struct PackedTriangle {
@@ -145,6 +149,18 @@ impl Accel {
         if self.tris.is_empty() {
             return None;
         }
+        if self.tris.len() <= BRUTE_FORCE {
+            let (o, d) = (Vec3A::from(o), Vec3A::from(d));
+            let mut best = None;
+            let mut tmax = tmax;
+            for (i, tri) in self.tris.iter().enumerate() {
+                if let Some((t, u, v)) = intersect_triangle(tri, o, d, tmin, tmax) {
+                    tmax = t;
+                    best = Some((i, u, v));
+                }
+            }
+            return best.map(|(i, u, v)| self.hit(i, tmax, u, v));
+        }
         let ray = BvhRay::new(o.into(), positive_zeros(d).into(), tmin, tmax);
         let mut hit = RayHit::none();
         let (mut bu, mut bv) = (0.0, 0.0);
@@ -159,17 +175,21 @@ impl Accel {
                 None => f32::INFINITY,
             }
         });
-        found.then(|| {
-            let tri = &self.tris[hit.primitive_id as usize];
-            Hit {
-                t: hit.t,
-                key: self.keys[hit.primitive_id as usize],
-                u: bu,
-                v: bv,
-                p: (tri.v0 + tri.e1 * bu + tri.e2 * bv).into(),
-                ng: tri.e1.cross(tri.e2).into(),
-            }
-        })
+        found.then(|| self.hit(hit.primitive_id as usize, hit.t, bu, bv))
+    }
+
+    /// The hit record of stored triangle `i` at `(t, u, v)`.
+    #[inline]
+    fn hit(&self, i: usize, t: f32, u: f32, v: f32) -> Hit {
+        let tri = &self.tris[i];
+        Hit {
+            t,
+            key: self.keys[i],
+            u,
+            v,
+            p: (tri.v0 + tri.e1 * u + tri.e2 * v).into(),
+            ng: tri.e1.cross(tri.e2).into(),
+        }
     }
 
     /// True when any triangle lies on the ray with `t` in `(tmin, tmax)`.
@@ -177,6 +197,10 @@ impl Accel {
     pub fn occluded(&self, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> bool {
         if self.tris.is_empty() {
             return false;
+        }
+        if self.tris.len() <= BRUTE_FORCE {
+            let (o, d) = (Vec3A::from(o), Vec3A::from(d));
+            return (self.tris.iter()).any(|t| intersect_triangle(t, o, d, tmin, tmax).is_some());
         }
         let ray = BvhRay::new(o.into(), positive_zeros(d).into(), tmin, tmax);
         let tris = &self.tris;
@@ -210,6 +234,19 @@ pub fn offset_origin(p: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
 mod tests {
     use super::*;
 
+    /// The BVH over `tris` as given (a few triangles: tested one by one) and with sixteen far
+    /// away triangles added (then the CWBVH is traversed).
+    fn both(tris: &[[Vec3; 3]]) -> [Accel; 2] {
+        let mut padded = tris.to_vec();
+        for i in 0..16 {
+            let c = Vec3::new(1000.0 + i as f32, 1000.0, 0.0);
+            padded.push([c, c + Vec3::X, c + Vec3::Y]);
+        }
+        let [a, b] = [Accel::build(tris), Accel::build(&padded)];
+        assert!(a.tris.len() <= BRUTE_FORCE && b.tris.len() > BRUTE_FORCE);
+        [a, b]
+    }
+
     fn quad(z: f32) -> Vec<[Vec3; 3]> {
         let a = Vec3::new(-1.0, -1.0, z);
         let b = Vec3::new(1.0, -1.0, z);
@@ -222,49 +259,52 @@ mod tests {
     fn closest_hit_and_occlusion() {
         let mut tris = quad(0.0);
         tris.extend(quad(-2.0));
-        let accel = Accel::build(&tris);
-        let h = accel
-            .intersect(Vec3::new(0.2, 0.3, 5.0), -Vec3::Z, 0.0, f32::INFINITY)
-            .unwrap();
-        assert!((h.t - 5.0).abs() < 1e-5);
-        assert!(h.key[1] < 2, "nearest quad is the first one");
-        assert!(accel.occluded(Vec3::new(0.2, 0.3, 5.0), -Vec3::Z, 0.0, 6.0));
-        assert!(!accel.occluded(Vec3::new(0.2, 0.3, 5.0), -Vec3::Z, 0.0, 4.9));
-        assert!(
-            accel
-                .intersect(Vec3::new(3.0, 0.0, 5.0), -Vec3::Z, 0.0, f32::INFINITY)
-                .is_none()
-        );
-    }
-
-    #[test]
-    fn shared_edge_has_no_gap() {
-        // Rays through the diagonal shared by the two triangles must hit one of them.
-        let accel = Accel::build(&quad(0.0));
-        for i in 0..1000 {
-            let s = -0.99 + 1.98 * i as f32 / 999.0;
-            let o = Vec3::new(s, s, 1.0);
+        for accel in both(&tris) {
+            let h = accel
+                .intersect(Vec3::new(0.2, 0.3, 5.0), -Vec3::Z, 0.0, f32::INFINITY)
+                .unwrap();
+            assert!((h.t - 5.0).abs() < 1e-5);
+            assert!(h.key[1] < 2, "nearest quad is the first one");
+            assert!(accel.occluded(Vec3::new(0.2, 0.3, 5.0), -Vec3::Z, 0.0, 6.0));
+            assert!(!accel.occluded(Vec3::new(0.2, 0.3, 5.0), -Vec3::Z, 0.0, 4.9));
             assert!(
-                accel.intersect(o, -Vec3::Z, 0.0, 10.0).is_some(),
-                "gap at {s}"
+                accel
+                    .intersect(Vec3::new(3.0, 0.0, 5.0), -Vec3::Z, 0.0, f32::INFINITY)
+                    .is_none()
             );
         }
     }
 
     #[test]
+    fn shared_edge_has_no_gap() {
+        // Rays through the diagonal shared by the two triangles must hit one of them.
+        for accel in both(&quad(0.0)) {
+            for i in 0..1000 {
+                let s = -0.99 + 1.98 * i as f32 / 999.0;
+                let o = Vec3::new(s, s, 1.0);
+                assert!(
+                    accel.intersect(o, -Vec3::Z, 0.0, 10.0).is_some(),
+                    "gap at {s}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn negative_zero_direction_components_hit() {
-        let accel = Accel::build(&quad(0.0));
-        for d in [
-            Vec3::new(-0.0, 0.0, -1.0),
-            Vec3::new(0.0, -0.0, -1.0),
-            Vec3::new(-0.0, -0.0, -1.0),
-        ] {
-            assert!(
-                accel
-                    .intersect(Vec3::new(0.3, 0.2, 1.0), d, 0.0, 10.0)
-                    .is_some()
-            );
-            assert!(accel.occluded(Vec3::new(0.3, 0.2, 1.0), d, 0.0, 10.0));
+        for accel in both(&quad(0.0)) {
+            for d in [
+                Vec3::new(-0.0, 0.0, -1.0),
+                Vec3::new(0.0, -0.0, -1.0),
+                Vec3::new(-0.0, -0.0, -1.0),
+            ] {
+                assert!(
+                    accel
+                        .intersect(Vec3::new(0.3, 0.2, 1.0), d, 0.0, 10.0)
+                        .is_some()
+                );
+                assert!(accel.occluded(Vec3::new(0.3, 0.2, 1.0), d, 0.0, 10.0));
+            }
         }
     }
 
@@ -277,28 +317,62 @@ mod tests {
             tris.push([Vec3::ZERO, Vec3::new(x, 0.0, 0.0), Vec3::new(0.0, x, 0.0)]);
         }
         tris.push([Vec3::ZERO, Vec3::INFINITY, Vec3::NAN]);
-        let accel = Accel::build(&tris);
-        let h = accel
-            .intersect(Vec3::new(0.5, 0.5, 1.0), -Vec3::Z, 0.0, f32::INFINITY)
-            .unwrap();
-        assert!(h.key[1] < 2 && (h.t - 1.0).abs() < 1e-6);
-        assert!(
-            accel
-                .intersect(Vec3::new(5.0, 5.0, 1.0), -Vec3::Z, 0.0, f32::INFINITY)
-                .is_none()
-        );
+        for accel in both(&tris) {
+            let h = accel
+                .intersect(Vec3::new(0.5, 0.5, 1.0), -Vec3::Z, 0.0, f32::INFINITY)
+                .unwrap();
+            assert!(h.key[1] < 2 && (h.t - 1.0).abs() < 1e-6);
+            assert!(
+                accel
+                    .intersect(Vec3::new(5.0, 5.0, 1.0), -Vec3::Z, 0.0, f32::INFINITY)
+                    .is_none()
+            );
+        }
     }
 
     #[test]
     fn barycentrics_locate_the_hit() {
         let tri = [Vec3::ZERO, Vec3::X, Vec3::Y];
-        let accel = Accel::build(&[tri]);
-        let h = accel
-            .intersect(Vec3::new(0.25, 0.5, 1.0), -Vec3::Z, 0.0, 10.0)
-            .unwrap();
-        assert!((h.u - 0.25).abs() < 1e-6 && (h.v - 0.5).abs() < 1e-6);
-        assert!((h.p - Vec3::new(0.25, 0.5, 0.0)).length() < 1e-6);
-        assert_eq!(h.ng, Vec3::Z);
-        assert_eq!(h.key, [0, 0]);
+        for accel in both(&[tri]) {
+            let h = accel
+                .intersect(Vec3::new(0.25, 0.5, 1.0), -Vec3::Z, 0.0, 10.0)
+                .unwrap();
+            assert!((h.u - 0.25).abs() < 1e-6 && (h.v - 0.5).abs() < 1e-6);
+            assert!((h.p - Vec3::new(0.25, 0.5, 0.0)).length() < 1e-6);
+            assert_eq!(h.ng, Vec3::Z);
+            assert_eq!(h.key, [0, 0]);
+        }
+    }
+
+    #[test]
+    fn testing_each_triangle_agrees_with_the_bvh() {
+        // Eight random triangles, random rays: the same closest hits and occlusion either way.
+        let mut state = 0x853c_49e6_748f_ea9bu64;
+        let mut rnd = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+        };
+        let mut v = move || Vec3::new(rnd(), rnd(), rnd());
+        let tris: Vec<[Vec3; 3]> = (0..8).map(|_| [v(), v(), v()]).collect();
+        let [small, big] = both(&tris);
+        let mut hits = 0;
+        for _ in 0..20_000 {
+            let o = v() * 3.0;
+            let d = (v() - o * 0.3).normalize();
+            let tmax = 3.0 + 2.0 * v().x;
+            let (a, b) = (
+                small.intersect(o, d, 0.0, tmax),
+                big.intersect(o, d, 0.0, tmax),
+            );
+            assert_eq!(a.map(|h| (h.t, h.key)), b.map(|h| (h.t, h.key)));
+            assert_eq!(
+                small.occluded(o, d, 0.0, tmax),
+                big.occluded(o, d, 0.0, tmax)
+            );
+            hits += a.is_some() as u32;
+        }
+        assert!(hits > 1000, "{hits} hits");
     }
 }
