@@ -114,8 +114,9 @@ impl AreaEmitter {
         );
         let b0 = 1.0 - b1 - b2;
         let [i0, i1, i2] = mesh.indices[tri].map(|i| i as usize);
-        let p = mesh.positions[i0] * b0 + mesh.positions[i1] * b1 + mesh.positions[i2] * b2;
-        let ng = triangle_cross(mesh, tri).normalize();
+        let (p0, p1, p2) = (mesh.positions[i0], mesh.positions[i1], mesh.positions[i2]);
+        let p = p0 * b0 + p1 * b1 + p2 * b2;
+        let ng = (p1 - p0).cross(p2 - p0).normalize();
         let mut n = ng;
         if !mesh.normals.is_empty() {
             let s = mesh.normals[i0] * b0 + mesh.normals[i1] * b1 + mesh.normals[i2] * b2;
@@ -135,6 +136,7 @@ impl AreaEmitter {
 }
 
 impl Emitter for AreaEmitter {
+    #[inline]
     fn sample(&self, scene: &Scene, rec: &mut EmitterQueryRecord, u: Vec2) -> Vec3 {
         let mesh = &scene.meshes[self.mesh];
         let (p, n, ng, uv) = self.sample_point(mesh, u);
@@ -157,6 +159,7 @@ impl Emitter for AreaEmitter {
         self.eval(scene, rec) / rec.pdf
     }
 
+    #[inline]
     fn eval(&self, scene: &Scene, rec: &EmitterQueryRecord) -> Vec3 {
         let cos = rec.n.dot(-rec.wi);
         if !self.two_sided && cos <= 0.0 {
@@ -165,6 +168,7 @@ impl Emitter for AreaEmitter {
         self.radiance_at(scene, rec.uv)
     }
 
+    #[inline]
     fn pdf(&self, _scene: &Scene, rec: &EmitterQueryRecord) -> f32 {
         let cos = rec.ng.dot(rec.wi).abs();
         if cos <= 0.0 {
