@@ -78,11 +78,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let count = |k: RayKind| rays.iter().filter(|r| r.kind == k).count();
 
     // 3a. Tesela, the renderer's way.
-    let mut ctx = Ctx {
-        sampler: SobolSampler::new(0, 0, 0),
-        rays: 0,
-        log: None,
-    };
+    let mut ctx = Ctx::new(SobolSampler::new(0, 0, 0));
     let accel = rs.accel();
     let (own_s, own_hits) = best_of(3, || {
         let mut hits = 0usize;

@@ -139,8 +139,8 @@ pub fn validate(opts: &RenderOptions) -> Result<(), RenderError> {
     Ok(())
 }
 
-/// Renders one pixel's samples; returns the mean radiance of the accepted samples. With `log`,
-/// every scene-BVH query is appended to it.
+/// Renders one pixel's samples with the thread's context `ctx` (its ray count and log carry
+/// on); returns the mean radiance of the accepted samples.
 #[inline]
 #[allow(clippy::too_many_arguments)]
 fn render_pixel(
@@ -150,24 +150,17 @@ fn render_pixel(
     opts: &RenderOptions,
     px: u32,
     py: u32,
-    rays: &mut u64,
+    ctx: &mut Ctx,
     rejected: &mut u64,
-    log: &mut Option<Vec<RayQuery>>,
 ) -> [f32; 4] {
     let pixel_index = py as u64 * opts.width as u64 + px as u64;
     let mut sum = Vec3::ZERO;
     let mut accepted = 0u32;
     for s in 0..opts.spp {
-        let mut ctx = Ctx {
-            sampler: SobolSampler::new(opts.seed, pixel_index, s as u64),
-            rays: 0,
-            log: log.take(),
-        };
+        ctx.sampler = SobolSampler::new(opts.seed, pixel_index, s as u64);
         let film = Vec2::new(px as f32, py as f32) + ctx.sampler.next_2d();
         let (o, d) = camera.ray(film);
-        let l = integrator.li(scene, &mut ctx, o, d);
-        *rays += ctx.rays;
-        *log = ctx.log;
+        let l = integrator.li(scene, ctx, o, d);
         if l.is_finite() && l.min_element() >= 0.0 {
             sum += l;
             accepted += 1;
@@ -194,8 +187,9 @@ pub fn record_rays(
         .ok_or_else(|| RenderError::Invalid("unknown integrator".into()))?;
     let camera = RayCamera::new(&scene.scene, opts.width, opts.height);
     let [rx, ry, rw, rh] = opts.region.unwrap_or([0, 0, opts.width, opts.height]);
-    let mut log = Some(Vec::new());
-    let (mut rays, mut rejected) = (0, 0);
+    let mut ctx = Ctx::new(SobolSampler::new(0, 0, 0));
+    ctx.log = Some(Vec::new());
+    let mut rejected = 0;
     for y in ry..ry + rh {
         for x in rx..rx + rw {
             render_pixel(
@@ -205,13 +199,12 @@ pub fn record_rays(
                 opts,
                 x,
                 y,
-                &mut rays,
+                &mut ctx,
                 &mut rejected,
-                &mut log,
             );
         }
     }
-    Ok(log.unwrap_or_default())
+    Ok(ctx.log.unwrap_or_default())
 }
 
 /// Renders the image. `on_tile(tile, tiles_done, tiles_total)` runs on a worker thread as each
@@ -249,8 +242,8 @@ pub fn render(
             .par_iter()
             .map(|&(tx, ty, tw, th)| {
                 let mut pixels = Vec::with_capacity((tw * th) as usize);
-                let (mut r, mut rej) = (0u64, 0u64);
-                let mut log = None;
+                let mut ctx = Ctx::new(SobolSampler::new(0, 0, 0));
+                let mut rej = 0u64;
                 for y in 0..th {
                     if cancel.load(Ordering::Relaxed) {
                         return Err(RenderError::Cancelled);
@@ -263,13 +256,12 @@ pub fn render(
                             opts,
                             rx + tx + x,
                             ry + ty + y,
-                            &mut r,
+                            &mut ctx,
                             &mut rej,
-                            &mut log,
                         ));
                     }
                 }
-                rays.fetch_add(r, Ordering::Relaxed);
+                rays.fetch_add(ctx.rays, Ordering::Relaxed);
                 rejected.fetch_add(rej, Ordering::Relaxed);
                 let tile = Tile {
                     x: tx,

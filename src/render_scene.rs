@@ -1,7 +1,7 @@
 //! A scene prepared for rendering: the BVH, the emitters and the light-selection
 //! distribution, with the surface queries the integrators need.
 
-use crate::accel::{Accel, Hit, offset_origin};
+use crate::accel::{Accel, Hit, Traversal, offset_origin};
 use crate::bsdf::SurfaceParams;
 use crate::emitter::{
     AreaEmitter, Background, Directional, Emitter, EmitterInstance, EmitterQueryRecord,
@@ -101,9 +101,21 @@ pub struct Ctx {
     pub rays: u64,
     /// When set, every ray cast is appended (`benches/traversal.rs` replays them).
     pub log: Option<Vec<RayQuery>>,
+    /// BVH traversal scratch, reused by every ray of the thread.
+    pub trav: Traversal,
 }
 
 impl Ctx {
+    /// A context with `sampler`, no rays counted, not recording.
+    pub fn new(sampler: crate::sampler::SobolSampler) -> Ctx {
+        Ctx {
+            sampler,
+            rays: 0,
+            log: None,
+            trav: Traversal::default(),
+        }
+    }
+
     /// Counts a ray and records it if recording.
     #[inline(always)]
     fn cast(&mut self, o: Vec3, d: Vec3, tmax: f32, kind: RayKind) {
@@ -218,7 +230,9 @@ impl RenderScene {
     #[inline]
     pub fn intersect(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Option<Intersection> {
         ctx.cast(o, d, f32::INFINITY, RayKind::Closest);
-        let hit = self.accel.intersect(o, d, 0.0, f32::INFINITY)?;
+        let hit = self
+            .accel
+            .intersect_with(&mut ctx.trav, o, d, 0.0, f32::INFINITY)?;
         Some(self.intersection(&hit, d))
     }
 
@@ -238,7 +252,7 @@ impl RenderScene {
             };
         };
         ctx.cast(o, d, f32::INFINITY, RayKind::Emission);
-        if let Some(hit) = emissive.intersect(o, d, 0.0, f32::INFINITY) {
+        if let Some(hit) = emissive.intersect_with(&mut ctx.trav, o, d, 0.0, f32::INFINITY) {
             let its = self.intersection(&hit, d);
             let (e, le, rec) = self.emitted(&its, o)?;
             if le == Vec3::ZERO {
@@ -246,13 +260,13 @@ impl RenderScene {
             }
             // Only a nearer surface can block it (`t < hit.t` excludes the emitter itself:
             // both BVHs hold the same triangle, intersected with the same arithmetic).
-            if self.accel.occluded(o, d, 0.0, hit.t) {
+            if self.accel.occluded_with(&mut ctx.trav, o, d, 0.0, hit.t) {
                 return None;
             }
             return Some((e, le, rec));
         }
         self.background?;
-        if self.accel.occluded(o, d, 0.0, f32::INFINITY) {
+        if (self.accel).occluded_with(&mut ctx.trav, o, d, 0.0, f32::INFINITY) {
             return None;
         }
         self.background_radiance(d, o)
@@ -336,10 +350,10 @@ impl RenderScene {
             }
             let (d, tmax) = (d / dist, dist * (1.0 - 1e-6));
             ctx.cast(o, d, tmax, RayKind::Any);
-            !self.accel.occluded(o, d, 0.0, tmax)
+            !self.accel.occluded_with(&mut ctx.trav, o, d, 0.0, tmax)
         } else {
             ctx.cast(o, rec.wi, f32::INFINITY, RayKind::Any);
-            !self.accel.occluded(o, rec.wi, 0.0, f32::INFINITY)
+            !(self.accel).occluded_with(&mut ctx.trav, o, rec.wi, 0.0, f32::INFINITY)
         }
     }
 
@@ -453,11 +467,7 @@ mod tests {
             assert!(rs.emitter_accel.is_some());
             let (lo, hi) = rs.scene.bounds().unwrap();
             let mut rng = Sampler::new(7, 0, 0);
-            let mut ctx = Ctx {
-                sampler: SobolSampler::new(0, 0, 0),
-                rays: 0,
-                log: None,
-            };
+            let mut ctx = Ctx::new(SobolSampler::new(0, 0, 0));
             let (mut lit, mut blocked, mut escaped) = (0, 0, 0);
             for _ in 0..400_000 {
                 let u = Vec3::new(rng.next_1d(), rng.next_1d(), rng.next_1d());
