@@ -64,6 +64,7 @@ pub struct Image {
 pub struct RenderStats {
     pub seconds: f64,
     pub samples: u64,
+    /// Rays cast (see [`Ctx::rays`]).
     pub rays: u64,
     pub samples_per_second: f64,
     pub rays_per_second: f64,

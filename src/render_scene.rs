@@ -97,7 +97,8 @@ pub struct RayQuery {
 /// Per-path-sample state: the random stream and counters.
 pub struct Ctx {
     pub sampler: crate::sampler::SobolSampler,
-    /// Rays traced (camera, bounce and shadow rays).
+    /// Rays cast: camera, bounce and shadow rays, and the last segments of paths however
+    /// they are answered ([`RenderScene::emission_along`] may need no traversal at all).
     pub rays: u64,
     /// When set, every ray cast is appended (`benches/traversal.rs` replays them).
     pub log: Option<Vec<RayQuery>>,
