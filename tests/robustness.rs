@@ -27,6 +27,10 @@ use tesela::scene::builtin::{cornell_box, look_at, quad, sphere};
 use tesela::scene::gltf::load_from_slice;
 use tesela::scene::{Camera, Light, Material, Mesh, Projection, Scene, SpotFalloff};
 
+#[path = "common/glb.rs"]
+mod glb_common;
+use glb_common::{glb, json_bytes as to_bytes};
+
 // ---------------------------------------------------------------------------------------
 // Running the CLI
 // ---------------------------------------------------------------------------------------
@@ -167,32 +171,6 @@ fn triangle_doc(positions: &[f32; 9]) -> Value {
 }
 
 const TRI: [f32; 9] = [0., 0., 0., 1., 0., 0., 0., 1., 0.];
-
-fn to_bytes(v: &Value) -> Vec<u8> {
-    serde_json::to_vec(v).unwrap()
-}
-
-/// A GLB holding `json` and `bin`.
-fn glb(json: &[u8], bin: &[u8]) -> Vec<u8> {
-    let mut j = json.to_vec();
-    while !j.len().is_multiple_of(4) {
-        j.push(b' ');
-    }
-    let mut b = bin.to_vec();
-    while !b.len().is_multiple_of(4) {
-        b.push(0);
-    }
-    let mut out = b"glTF".to_vec();
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&((12 + 8 + j.len() + 8 + b.len()) as u32).to_le_bytes());
-    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&j);
-    out.extend_from_slice(&(b.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&b);
-    out
-}
 
 /// The one-triangle document as a GLB (buffer 0 is the BIN chunk).
 fn triangle_glb() -> Vec<u8> {
