@@ -177,17 +177,36 @@ fn render_pixel(
     [c.x, c.y, c.z, 1.0]
 }
 
-/// The scene-BVH queries a render with `opts` makes, in pixel order on one thread (for the
-/// traversal benchmark: `benches/traversal.rs`).
+/// What every render with `opts` starts from.
+struct Prepared {
+    integrator: Box<dyn Integrator>,
+    camera: RayCamera,
+    /// The pixel window `[x, y, w, h]`.
+    region: [u32; 4],
+}
+
+/// Checks `opts` and sets up the integrator, the camera and the pixel window.
+fn prepare(scene: &RenderScene, opts: &RenderOptions) -> Result<Prepared, RenderError> {
+    validate(opts)?;
+    Ok(Prepared {
+        integrator: integrator::by_name(&opts.integrator, opts.max_depth.max(1))
+            .ok_or_else(|| RenderError::Invalid("unknown integrator".into()))?,
+        camera: RayCamera::new(&scene.scene, opts.width, opts.height),
+        region: opts.region.unwrap_or([0, 0, opts.width, opts.height]),
+    })
+}
+
+/// Every ray a render with `opts` casts, in pixel order on one thread (for the traversal
+/// benchmark: `benches/traversal.rs`).
 pub fn record_rays(
     scene: &RenderScene,
     opts: &RenderOptions,
 ) -> Result<Vec<RayQuery>, RenderError> {
-    validate(opts)?;
-    let integrator = integrator::by_name(&opts.integrator, opts.max_depth.max(1))
-        .ok_or_else(|| RenderError::Invalid("unknown integrator".into()))?;
-    let camera = RayCamera::new(&scene.scene, opts.width, opts.height);
-    let [rx, ry, rw, rh] = opts.region.unwrap_or([0, 0, opts.width, opts.height]);
+    let Prepared {
+        integrator,
+        camera,
+        region: [rx, ry, rw, rh],
+    } = prepare(scene, opts)?;
     let mut ctx = Ctx::new(SobolSampler::new(0, 0, 0));
     ctx.log = Some(Vec::new());
     let mut rejected = 0;
@@ -216,11 +235,11 @@ pub fn render(
     cancel: &AtomicBool,
     on_tile: &(dyn Fn(&Tile, usize, usize) + Sync),
 ) -> Result<(Image, RenderStats), RenderError> {
-    validate(opts)?;
-    let integrator = integrator::by_name(&opts.integrator, opts.max_depth.max(1))
-        .ok_or_else(|| RenderError::Invalid("unknown integrator".into()))?;
-    let camera = RayCamera::new(&scene.scene, opts.width, opts.height);
-    let [rx, ry, rw, rh] = opts.region.unwrap_or([0, 0, opts.width, opts.height]);
+    let Prepared {
+        integrator,
+        camera,
+        region: [rx, ry, rw, rh],
+    } = prepare(scene, opts)?;
     let ts = opts.tile_size.max(1);
     let mut tiles = Vec::new();
     for ty in (0..rh).step_by(ts as usize) {

@@ -247,10 +247,7 @@ impl RenderScene {
     #[inline]
     pub fn emission_along(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Emitted {
         let Some(emissive) = &self.emitter_accel else {
-            return match self.intersect(ctx, o, d) {
-                Some(its) => self.emitted(&its, o),
-                None => self.background_radiance(d, o),
-            };
+            return self.emission_at(self.intersect(ctx, o, d).as_ref(), o, d);
         };
         ctx.cast(o, d, f32::INFINITY, RayKind::Emission);
         if let Some(hit) = emissive.intersect_with(&mut ctx.trav, o, d, 0.0, f32::INFINITY) {
@@ -396,6 +393,16 @@ impl RenderScene {
         Some((e, le, rec))
     }
 
+    /// The radiance a ray from `o` along `d` meets at `hit`: that surface's emission, or the
+    /// background's if the ray escaped (`hit` is `None`).
+    #[inline]
+    pub fn emission_at(&self, hit: Option<&Intersection>, o: Vec3, d: Vec3) -> Emitted {
+        match hit {
+            Some(its) => self.emitted(its, o),
+            None => self.background_radiance(d, o),
+        }
+    }
+
     /// Background radiance for a ray leaving the scene along `d` from `from`.
     #[inline]
     pub fn background_radiance(&self, d: Vec3, from: Vec3) -> Emitted {
@@ -476,10 +483,7 @@ mod tests {
                 let o = lo - (hi - lo) * 0.05 + (hi - lo) * 1.1 * u;
                 let d = square_to_uniform_sphere(rng.next_2d());
                 let fast = rs.emission_along(&mut ctx, o, d);
-                let full = match rs.intersect(&mut ctx, o, d) {
-                    Some(its) => rs.emitted(&its, o),
-                    None => rs.background_radiance(d, o),
-                };
+                let full = rs.emission_at(rs.intersect(&mut ctx, o, d).as_ref(), o, d);
                 let full = full.filter(|(_, le, _)| *le != Vec3::ZERO);
                 match (&fast, &full) {
                     (Some((a, la, ra)), Some((b, lb, rb))) => {

@@ -183,10 +183,7 @@ pub fn trace_emitted(
         return (None, scene.emission_along(ctx, o, d));
     }
     let hit = scene.trace(ctx, o, d, depth);
-    let emitted = match &hit {
-        Some(its) => scene.emitted(its, o),
-        None => scene.background_radiance(d, o),
-    };
+    let emitted = scene.emission_at(hit.as_ref(), o, d);
     (hit, emitted)
 }
 
