@@ -103,8 +103,10 @@ const fn sobol1_directions() -> [u32; 32] {
     v
 }
 
-/// `SOBOL1_BYTES[b][x]`: XOR of the direction numbers selected by byte `b` of an index equal to `x`.
-const fn sobol1_byte_tables() -> [[u32; 256]; 4] {
+/// `SOBOL1_REV_BYTES[b][x]`: XOR of the bit-reversed direction numbers selected by byte `b` of
+/// an index equal to `x` (reversal commutes with XOR: the tables give the second Sobol
+/// dimension bit-reversed, which is what the sampler scrambles).
+const fn sobol1_rev_byte_tables() -> [[u32; 256]; 4] {
     let v = sobol1_directions();
     let mut t = [[0u32; 256]; 4];
     let mut b = 0;
@@ -115,7 +117,7 @@ const fn sobol1_byte_tables() -> [[u32; 256]; 4] {
             let mut bit = 0;
             while bit < 8 {
                 if x & (1 << bit) != 0 {
-                    r ^= v[8 * b + bit];
+                    r ^= v[8 * b + bit].reverse_bits();
                 }
                 bit += 1;
             }
@@ -127,38 +129,10 @@ const fn sobol1_byte_tables() -> [[u32; 256]; 4] {
     t
 }
 
-#[cfg(test)]
-static SOBOL1_BYTES: [[u32; 256]; 4] = sobol1_byte_tables();
+static SOBOL1_REV_BYTES: [[u32; 256]; 4] = sobol1_rev_byte_tables();
 
-/// [`SOBOL1_BYTES`] with every entry bit-reversed: `sobol1_rev(i) = sobol1(i).reverse_bits()`.
-const fn reversed(t: [[u32; 256]; 4]) -> [[u32; 256]; 4] {
-    let mut r = t;
-    let mut b = 0;
-    while b < 4 {
-        let mut x = 0;
-        while x < 256 {
-            r[b][x] = t[b][x].reverse_bits();
-            x += 1;
-        }
-        b += 1;
-    }
-    r
-}
-
-static SOBOL1_REV_BYTES: [[u32; 256]; 4] = reversed(sobol1_byte_tables());
-
-/// Second dimension of the Sobol sequence (generator: Pascal's triangle mod 2), four table
-/// lookups per point (the sampler uses its bit-reversed twin [`sobol1_rev`]).
-#[cfg(test)]
-fn sobol1(i: u32) -> u32 {
-    let b = i.to_le_bytes();
-    SOBOL1_BYTES[0][b[0] as usize]
-        ^ SOBOL1_BYTES[1][b[1] as usize]
-        ^ SOBOL1_BYTES[2][b[2] as usize]
-        ^ SOBOL1_BYTES[3][b[3] as usize]
-}
-
-/// `sobol1(i).reverse_bits()`, from the reversed tables.
+/// The second dimension of the Sobol sequence (generator: Pascal's triangle mod 2) at index
+/// `i`, bit-reversed; four table lookups.
 #[inline]
 fn sobol1_rev(i: u32) -> u32 {
     let b = i.to_le_bytes();
@@ -305,22 +279,21 @@ mod tests {
                 assert_eq!(b.next_1d(), to_unit(x1), "1D dimension {k}");
             }
         }
-        for i in [0u32, 1, 5, 0xdead_beef, u32::MAX] {
-            assert_eq!(sobol1_rev(i), sobol1(i).reverse_bits());
-        }
+    }
+
+    /// The second Sobol dimension by its definition: the XOR of the direction numbers the
+    /// index's bits select.
+    fn sobol1(i: u32) -> u32 {
+        let v = sobol1_directions();
+        (0..32)
+            .filter(|k| i & (1 << k) != 0)
+            .fold(0, |r, k| r ^ v[k])
     }
 
     #[test]
     fn sobol1_table_matches_definition() {
-        let v = sobol1_directions();
-        for i in [0u32, 1, 2, 3, 255, 256, 0xdead_beef, u32::MAX] {
-            let mut r = 0;
-            for (k, d) in v.iter().enumerate() {
-                if i & (1 << k) != 0 {
-                    r ^= d;
-                }
-            }
-            assert_eq!(sobol1(i), r, "index {i}");
+        for i in [0u32, 1, 2, 3, 5, 255, 256, 0xdead_beef, u32::MAX] {
+            assert_eq!(sobol1_rev(i), sobol1(i).reverse_bits(), "index {i}");
         }
         assert_eq!(sobol1(1), 1 << 31);
         assert_eq!(sobol1(2), 3 << 30);
