@@ -8,9 +8,9 @@ use serde_json::{Value, json};
 use tesela::scene::LoadErrorKind;
 use tesela::scene::gltf::{load, load_from_slice};
 
-#[path = "common/glb.rs"]
-mod glb_common;
-use glb_common::{glb, json_bytes as bytes};
+#[path = "common/inputs.rs"]
+mod inputs;
+use inputs::{glb, json_bytes as bytes, write};
 
 fn b64(bytes: &[u8]) -> String {
     base64::engine::general_purpose::STANDARD.encode(bytes)
@@ -82,16 +82,7 @@ fn assert_contains(msg: &str, what: &str) {
 
 /// A fresh folder for file-based cases.
 fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tesela-gltf-errors-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn write(dir: &Path, name: &str, data: &[u8]) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, data).unwrap();
-    p
+    inputs::scratch("gltf-errors", name)
 }
 
 #[test]

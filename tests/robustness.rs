@@ -27,9 +27,9 @@ use tesela::scene::builtin::{cornell_box, look_at, quad, sphere};
 use tesela::scene::gltf::load_from_slice;
 use tesela::scene::{Camera, Light, Material, Mesh, Projection, Scene, SpotFalloff};
 
-#[path = "common/glb.rs"]
-mod glb_common;
-use glb_common::{glb, json_bytes as to_bytes};
+#[path = "common/inputs.rs"]
+mod inputs;
+use inputs::{glb, json_bytes as to_bytes};
 
 // ---------------------------------------------------------------------------------------
 // Running the CLI
@@ -115,16 +115,12 @@ fn expect_failure(args: &[&str], code: i32, needles: &[&str]) -> String {
 
 /// A fresh folder for one test.
 fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tesela-robustness-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    inputs::scratch("robustness", name)
 }
 
+/// Writes `dir/name` and returns its path as a command-line argument.
 fn write(dir: &Path, name: &str, data: &[u8]) -> String {
-    let p = dir.join(name);
-    std::fs::write(&p, data).unwrap();
-    p.to_str().unwrap().to_string()
+    s(&inputs::write(dir, name, data)).to_string()
 }
 
 fn s(p: &Path) -> &str {

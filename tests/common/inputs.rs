@@ -1,10 +1,12 @@
-//! Building glTF test inputs in memory: a JSON document's bytes, and a GLB container.
+//! Building test inputs: a JSON document's bytes, a GLB container, and files in a fresh
+//! scratch folder.
 //!
-//! Included from the test crates with `#[path = "common/glb.rs"] mod glb_common;`.
+//! Included from the test crates with `#[path = "common/inputs.rs"] mod inputs;`.
 
 #![allow(dead_code)]
 
 use serde_json::Value;
+use std::path::{Path, PathBuf};
 
 /// The JSON text of `v`.
 pub fn json_bytes(v: &Value) -> Vec<u8> {
@@ -32,4 +34,19 @@ pub fn glb(json: &[u8], bin: &[u8]) -> Vec<u8> {
     out.extend_from_slice(b"BIN\0");
     out.extend_from_slice(&b);
     out
+}
+
+/// A fresh, empty folder `tesela-<suite>-<pid>-<name>` in the temporary directory.
+pub fn scratch(suite: &str, name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tesela-{suite}-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Writes `data` to `dir/name` and returns the path.
+pub fn write(dir: &Path, name: &str, data: &[u8]) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, data).unwrap();
+    p
 }
