@@ -17,4 +17,5 @@ pub mod render_scene;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod shading;
 pub mod texture;

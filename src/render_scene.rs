@@ -2,15 +2,16 @@
 //! distribution, with the surface queries the integrators need.
 
 use crate::accel::{Accel, Hit, Traversal, offset_origin};
-use crate::bsdf::SurfaceParams;
 use crate::emitter::{
     AreaEmitter, Background, Directional, Emitter, EmitterInstance, EmitterQueryRecord,
     LightChoice, LightSampler, PointLight, SpotLight,
 };
 use crate::frame::Frame;
 use crate::scene::{Light, Scene};
-use crate::texture;
-use glam::{Vec2, Vec3};
+use crate::shading::globals::{ShadeEnv, ShaderGlobals, to_blender};
+use crate::shading::{ClosureKind, Program};
+use glam::{Mat4, Vec2, Vec3};
+use std::sync::Arc;
 
 /// A ray–surface intersection with everything shading needs (world space).
 #[derive(Clone, Copy, Debug)]
@@ -24,6 +25,10 @@ pub struct Intersection {
     pub ns: Vec3,
     pub uv: Vec2,
     pub mesh: u32,
+    /// Triangle index within the mesh and barycentrics `(b1, b2)` of the hit.
+    pub tri: u32,
+    pub b1: f32,
+    pub b2: f32,
     pub material: u32,
     /// Index into [`RenderScene::emitters`] if the surface emits.
     pub emitter: Option<u32>,
@@ -97,6 +102,11 @@ pub struct RayQuery {
 /// Per-path-sample state: the random stream and counters.
 pub struct Ctx {
     pub sampler: crate::sampler::SobolSampler,
+    /// The shading program's slots and closures, reused by every shading point of the thread.
+    pub shade: crate::shading::Scratch,
+    /// What kind of ray the current path segment is (Light Path node bits), set when a BSDF
+    /// is sampled; camera rays are recognised by their depth.
+    pub ray_flags: u32,
     /// Rays cast: camera, bounce and shadow rays, and the last segments of paths however
     /// they are answered ([`RenderScene::emission_along`] may need no traversal at all).
     pub rays: u64,
@@ -111,6 +121,8 @@ impl Ctx {
     pub fn new(sampler: crate::sampler::SobolSampler) -> Ctx {
         Ctx {
             sampler,
+            shade: Default::default(),
+            ray_flags: 0,
             rays: 0,
             log: None,
             trav: Traversal::default(),
@@ -129,6 +141,10 @@ impl Ctx {
 
 pub struct RenderScene {
     pub scene: Scene,
+    /// Each material's compiled shading program (indexed like `scene.materials`).
+    pub programs: Vec<Arc<Program>>,
+    /// The camera in Blender's coordinates, for the graph's Camera coordinates.
+    camera_to_world: Mat4,
     accel: Accel,
     /// A BVH over the emissive triangles alone: rays whose only use is the emission they meet
     /// find it here first (see [`RenderScene::emission_along`]). `None` when emissive
@@ -158,14 +174,37 @@ impl RenderScene {
             None => 1.0,
         };
 
+        let mut warnings = Vec::new();
+        let programs: Vec<Arc<Program>> = scene
+            .materials
+            .iter()
+            .map(|m| {
+                let c = crate::shading::material_program(m, &scene.textures);
+                for w in c.warnings {
+                    if !warnings.contains(&w) {
+                        warnings.push(w);
+                    }
+                }
+                Arc::new(c.program)
+            })
+            .collect();
+        let camera_to_world = scene.camera.map_or(Mat4::IDENTITY, |c| {
+            let b = Mat4::from_cols(
+                glam::Vec4::X,
+                glam::Vec4::new(0.0, 0.0, 1.0, 0.0),
+                glam::Vec4::new(0.0, -1.0, 0.0, 0.0),
+                glam::Vec4::W,
+            );
+            b * c.to_world
+        });
         let mut emitters = Vec::new();
         let mut mesh_emitter = vec![None; scene.meshes.len()];
-        let mut warnings = Vec::new();
         for (mi, m) in scene.meshes.iter().enumerate() {
-            if !scene.materials[m.material].is_emissive() {
+            let program = &programs[m.material];
+            if !program.may_emit() {
                 continue;
             }
-            match AreaEmitter::new(&scene, mi) {
+            match AreaEmitter::with_program(&scene, mi, program.clone()) {
                 Some(e) => {
                     mesh_emitter[mi] = Some(emitters.len() as u32);
                     emitters.push(EmitterInstance::Area(e));
@@ -216,6 +255,8 @@ impl RenderScene {
         scene.warnings.extend(warnings);
         RenderScene {
             scene,
+            programs,
+            camera_to_world,
             accel,
             emitter_accel,
             triangles: n,
@@ -276,7 +317,6 @@ impl RenderScene {
         let [mi, ti] = hit.key;
         let mesh = &self.scene.meshes[mi as usize];
         let (b1, b2) = (hit.u, hit.v);
-        let b0 = 1.0 - b1 - b2;
         let len = hit.ng.length();
         let mut ng = if len > 0.0 && len.is_finite() {
             hit.ng / len
@@ -285,25 +325,13 @@ impl RenderScene {
         };
         // Vertex attributes only when the mesh has them (position and geometric normal come
         // with the hit).
-        let corners = || mesh.indices[ti as usize].map(|i| i as usize);
-        let mut ns = ng;
-        if !mesh.normals.is_empty() {
-            let [i0, i1, i2] = corners();
-            let s = mesh.normals[i0] * b0 + mesh.normals[i1] * b1 + mesh.normals[i2] * b2;
-            let l = s.length();
-            if l > 1e-12 && l.is_finite() {
-                ns = s / l;
-            }
-        }
+        let ns = mesh.shading_normal(ti, b1, b2).unwrap_or(ng);
         if ng.dot(ns) < 0.0 {
             ng = -ng;
         }
-        let uv = if mesh.uvs.is_empty() {
-            Vec2::ZERO
-        } else {
-            let [i0, i1, i2] = corners();
-            mesh.uvs[i0] * b0 + mesh.uvs[i1] * b1 + mesh.uvs[i2] * b2
-        };
+        let uv = mesh
+            .interpolate(&mesh.uvs, ti, b1, b2)
+            .unwrap_or(Vec2::ZERO);
         Intersection {
             t: hit.t,
             p: hit.p,
@@ -311,6 +339,9 @@ impl RenderScene {
             ns,
             uv,
             mesh: mi,
+            tri: ti,
+            b1,
+            b2,
             material: mesh.material as u32,
             emitter: self.mesh_emitter[mi as usize],
         }
@@ -355,32 +386,87 @@ impl RenderScene {
         }
     }
 
-    /// Material parameters at a hit, textures applied.
-    pub fn surface_params(&self, its: &Intersection) -> SurfaceParams {
-        let scene = &self.scene;
-        let m = &scene.materials[its.material as usize];
-        let mut base = m.base_color;
-        let mut metallic = m.metallic;
-        let mut roughness = m.roughness;
-        if let Some(t) = m.base_color_texture {
-            let tex = &scene.textures[t.texture];
-            base *= texture::lookup(tex, &scene.images[tex.image], its.uv, true).truncate();
+    /// The scene data shading programs may read.
+    #[inline]
+    pub fn shade_env(&self) -> ShadeEnv<'_> {
+        ShadeEnv {
+            images: &self.scene.images,
+            textures: &self.scene.textures,
+            camera_to_world: self.camera_to_world,
         }
-        if let Some(t) = m.metallic_roughness_texture {
-            let tex = &scene.textures[t.texture];
-            let s = texture::lookup(tex, &scene.images[tex.image], its.uv, false);
-            roughness *= s.y;
-            metallic *= s.z;
+    }
+
+    /// The shading point of a hit seen along the unit direction `d` at path vertex `depth`.
+    #[inline]
+    pub fn globals<'a>(
+        &'a self,
+        its: &Intersection,
+        d: Vec3,
+        depth: u32,
+        flags: u32,
+    ) -> ShaderGlobals<'a> {
+        let backfacing = its.ng.dot(d) > 0.0;
+        let (n, ng) = if backfacing {
+            (-its.ns, -its.ng)
+        } else {
+            (its.ns, its.ng)
+        };
+        ShaderGlobals {
+            p: to_blender(its.p),
+            n: to_blender(n),
+            ng: to_blender(ng),
+            i: to_blender(-d),
+            backfacing,
+            mesh: Some(&self.scene.meshes[its.mesh as usize]),
+            tri: its.tri,
+            b1: its.b1,
+            b2: its.b2,
+            uv0: its.uv,
+            ray_depth: depth,
+            ray_flags: flags,
         }
-        SurfaceParams {
-            base_color: base,
-            metallic,
-            roughness,
-            transmission: m.transmission,
-            ior: m.ior,
-            specular: m.specular,
-            specular_color: m.specular_color,
-        }
+    }
+
+    /// Evaluates the hit's material and chooses one BSDF closure with the random number `u`
+    /// (reused for the closure's own lobe choice): `(closure, 1 / choice probability)`, or
+    /// `None` when the material has no BSDF there.
+    #[inline]
+    pub fn choose_closure(
+        &self,
+        ctx: &mut Ctx,
+        its: &Intersection,
+        d: Vec3,
+        depth: u32,
+        u: f32,
+    ) -> Option<(crate::shading::Closure, f32, f32)> {
+        let program = &self.programs[its.material as usize];
+        let flags = if depth <= 1 {
+            crate::shading::globals::ray::CAMERA
+        } else {
+            ctx.ray_flags
+        };
+        let g = self.globals(its, d, depth, flags);
+        let env = self.shade_env();
+        let set = program.eval(&g, &env, &mut ctx.shade);
+        let (i, p, u) = set.choose(u)?;
+        Some((set.closures[i], 1.0 / p, u))
+    }
+
+    /// Surface albedo at a hit (the debug view): the chosen closure's colour.
+    pub fn albedo(&self, ctx: &mut Ctx, its: &Intersection, d: Vec3) -> Vec3 {
+        let Some((c, _, _)) = self.choose_closure(ctx, its, d, 1, 0.5) else {
+            return Vec3::ZERO;
+        };
+        c.weight
+            * match c.kind {
+                ClosureKind::Principled(p) => p.base_color,
+                ClosureKind::Diffuse { color }
+                | ClosureKind::Glossy { color, .. }
+                | ClosureKind::Glass { color, .. }
+                | ClosureKind::Refraction { color, .. }
+                | ClosureKind::Translucent { color }
+                | ClosureKind::Transparent { color } => color,
+            }
     }
 
     /// Radiance emitted by the hit surface towards `from` (the ray's origin), with the
@@ -388,7 +474,9 @@ impl RenderScene {
     #[inline]
     pub fn emitted(&self, its: &Intersection, from: Vec3) -> Emitted {
         let e = its.emitter?;
-        let rec = EmitterQueryRecord::between(from, its.p, its.ns, its.ng, its.uv);
+        let mut rec = EmitterQueryRecord::between(from, its.p, its.ns, its.ng, its.uv);
+        rec.tri = its.tri;
+        rec.bary = Vec2::new(its.b1, its.b2);
         let le = self.emitters[e as usize].eval(&self.scene, &rec);
         Some((e, le, rec))
     }

@@ -45,6 +45,23 @@ fn texel(img: &Image, x: usize, y: usize) -> Vec4 {
     Vec4::new(p[0] as f32, p[1] as f32, p[2] as f32, p[3] as f32) / 255.0
 }
 
+/// A float texel, linear (an sRGB-tagged float image is decoded per texel, before filtering,
+/// as Cycles converts float images to linear when it loads them).
+#[inline]
+fn texel_f(img: &Image, x: usize, y: usize, srgb: bool) -> Vec4 {
+    let v = Vec4::from_array(img.float[y * img.width as usize + x]);
+    if srgb {
+        Vec4::new(
+            srgb_to_linear(v.x),
+            srgb_to_linear(v.y),
+            srgb_to_linear(v.z),
+            v.w,
+        )
+    } else {
+        v
+    }
+}
+
 /// sRGB decode of a filtered encoded value in [0, 1].
 #[inline]
 fn srgb_to_linear(c: f32) -> f32 {
@@ -79,6 +96,26 @@ pub fn lookup(tex: &Texture, img: &Image, uv: Vec2, srgb: bool) -> Vec4 {
     // Keep coordinates in a range where i64 conversion is exact.
     let x = x.clamp(-1e9, 1e9);
     let y = y.clamp(-1e9, 1e9);
+    if !img.float.is_empty() {
+        if tex.nearest {
+            let xi = wrap((x + 0.5).floor() as i64, img.width, tex.wrap_s);
+            let yi = wrap((y + 0.5).floor() as i64, img.height, tex.wrap_t);
+            return texel_f(img, xi, yi, srgb);
+        }
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let xa = wrap(x0, img.width, tex.wrap_s);
+        let xb = wrap(x0 + 1, img.width, tex.wrap_s);
+        let ya = wrap(y0, img.height, tex.wrap_t);
+        let yb = wrap(y0 + 1, img.height, tex.wrap_t);
+        let top = texel_f(img, xa, ya, srgb).lerp(texel_f(img, xb, ya, srgb), fx);
+        let bottom = texel_f(img, xa, yb, srgb).lerp(texel_f(img, xb, yb, srgb), fx);
+        return top.lerp(bottom, fy);
+    }
+    if img.rgba8.is_empty() {
+        return Vec4::ONE;
+    }
     if tex.nearest {
         let xi = wrap((x + 0.5).floor() as i64, img.width, tex.wrap_s);
         let yi = wrap((y + 0.5).floor() as i64, img.height, tex.wrap_t);
@@ -114,6 +151,7 @@ mod tests {
         Image {
             width: 2,
             height: 2,
+            float: Vec::new(),
             rgba8: vec![
                 [255, 0, 0, 255],
                 [0, 255, 0, 255],

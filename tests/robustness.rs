@@ -763,6 +763,7 @@ fn mesh(name: &str, material: usize, positions: Vec<Vec3>, normals: Vec<Vec3>) -
         uvs: Vec::new(),
         material,
         hidden_from_camera: false,
+        attrs: Default::default(),
     }
 }
 

@@ -6,6 +6,7 @@
 //! `eval` returns `f(wi, wo)` **without** the cosine; `pdf` is per unit **solid angle** of `wo`;
 //! `sample` returns the weight `f · |cos θo| / pdf` (for delta lobes, the lobe's weight).
 
+pub mod closure;
 pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
@@ -15,6 +16,7 @@ pub mod plastic;
 
 use glam::{Vec2, Vec3};
 
+pub use closure::from_closure;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use microfacet::RoughConductor;

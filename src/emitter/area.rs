@@ -8,9 +8,11 @@
 use super::{Emitter, EmitterQueryRecord, luminance};
 use crate::sampling::{DiscreteCdf, square_to_uniform_triangle};
 use crate::scene::{Mesh, Scene};
-use crate::texture;
-use glam::{Vec2, Vec3};
+use crate::shading::Program;
+use crate::shading::globals::{ShadeEnv, ShaderGlobals, to_blender};
+use glam::{Mat4, Vec2, Vec3};
 use std::f32::consts::PI;
+use std::sync::Arc;
 
 /// Smallest barycentric weight of a sampled point (see [`AreaEmitter::sample_point`]).
 pub const EDGE_MARGIN: f32 = 1e-5;
@@ -23,8 +25,10 @@ pub struct AreaEmitter {
     pub cdf: DiscreteCdf,
     /// Total area `A` (m²).
     pub area: f32,
-    /// Emitted radiance factor (W m⁻² sr⁻¹), times the emissive texture if any.
+    /// Mean emitted radiance (W m⁻² sr⁻¹) over the mesh, for the light choice.
     pub radiance: Vec3,
+    /// The material's shading program, which gives the radiance at each point.
+    pub program: Arc<Program>,
     pub two_sided: bool,
 }
 
@@ -45,6 +49,14 @@ impl AreaEmitter {
     /// An emitter for `scene.meshes[mesh]`, or `None` if its emissive area is zero.
     pub fn new(scene: &Scene, mesh: usize) -> Option<AreaEmitter> {
         let m = &scene.meshes[mesh];
+        let program =
+            crate::shading::material_program(&scene.materials[m.material], &scene.textures);
+        AreaEmitter::with_program(scene, mesh, Arc::new(program.program))
+    }
+
+    /// An emitter for `scene.meshes[mesh]` whose radiance is `program`'s emission.
+    pub fn with_program(scene: &Scene, mesh: usize, program: Arc<Program>) -> Option<AreaEmitter> {
+        let m = &scene.meshes[mesh];
         let material = &scene.materials[m.material];
         let areas: Vec<f32> = (0..m.indices.len())
             .map(|i| 0.5 * triangle_cross(m, i).length())
@@ -53,26 +65,48 @@ impl AreaEmitter {
         if cdf.is_empty() {
             return None;
         }
+        let area = cdf.sum();
+        // Mean radiance: area-weighted over (up to 4096) triangle centroids.
+        let step = (m.indices.len() / 4096).max(1);
+        let (mut sum, mut weight) = (Vec3::ZERO, 0.0f32);
+        let varying = if program.is_empty() {
+            0
+        } else {
+            m.indices.len()
+        };
+        for i in (0..varying).step_by(step) {
+            let third = 1.0 / 3.0;
+            let le = radiance(scene, &program, m, i as u32, Vec2::splat(third));
+            sum += le * areas[i];
+            weight += areas[i];
+        }
+        let radiance = if program.is_empty() {
+            radiance(scene, &program, m, 0, Vec2::ZERO)
+        } else if weight > 0.0 {
+            sum / weight
+        } else {
+            Vec3::ZERO
+        };
         Some(AreaEmitter {
             mesh,
-            area: cdf.sum(),
+            area,
             cdf,
-            radiance: material.emission,
+            radiance,
+            program,
             two_sided: material.emission_two_sided,
         })
     }
 
-    /// Radiance factor at texture coordinates `uv` (before the sidedness test).
+    /// Radiance at the point of `rec` (before the sidedness test).
     #[inline]
-    fn radiance_at(&self, scene: &Scene, uv: Vec2) -> Vec3 {
-        let material = &scene.materials[scene.meshes[self.mesh].material];
-        match material.emission_texture {
-            Some(t) => {
-                let tex = &scene.textures[t.texture];
-                self.radiance * texture::lookup(tex, &scene.images[tex.image], uv, true).truncate()
-            }
-            None => self.radiance,
-        }
+    fn radiance_at(&self, scene: &Scene, rec: &EmitterQueryRecord) -> Vec3 {
+        radiance(
+            scene,
+            &self.program,
+            &scene.meshes[self.mesh],
+            rec.tri,
+            rec.bary,
+        )
     }
 
     /// Chooses a triangle with probability proportional to its area, and the two numbers that
@@ -100,9 +134,10 @@ impl AreaEmitter {
         )
     }
 
-    /// Uniform point on the mesh: `(position, shading normal, geometric unit normal, uv)`.
+    /// Uniform point on the mesh: `(position, shading normal, geometric unit normal, uv,
+    /// triangle, barycentrics)`.
     #[inline]
-    pub fn sample_point(&self, mesh: &Mesh, u: Vec2) -> (Vec3, Vec3, Vec3, Vec2) {
+    pub fn sample_point(&self, mesh: &Mesh, u: Vec2) -> (Vec3, Vec3, Vec3, Vec2, u32, Vec2) {
         let (tri, ua, ub) = self.choose_triangle(u);
         let b = square_to_uniform_triangle(Vec2::new(ua, ub));
         // Keep the point off the triangle's edges, where a light that touches other geometry
@@ -117,29 +152,55 @@ impl AreaEmitter {
         let (p0, p1, p2) = (mesh.positions[i0], mesh.positions[i1], mesh.positions[i2]);
         let p = p0 * b0 + p1 * b1 + p2 * b2;
         let ng = (p1 - p0).cross(p2 - p0).normalize();
-        let mut n = ng;
-        if !mesh.normals.is_empty() {
-            let s = mesh.normals[i0] * b0 + mesh.normals[i1] * b1 + mesh.normals[i2] * b2;
-            let l = s.length();
-            if l > 1e-12 && l.is_finite() {
-                n = s / l;
-            }
-        }
+        let tri = tri as u32;
+        let n = mesh.shading_normal(tri, b1, b2).unwrap_or(ng);
         let ng = if ng.dot(n) < 0.0 { -ng } else { ng };
-        let uv = if mesh.uvs.is_empty() {
-            Vec2::ZERO
-        } else {
-            mesh.uvs[i0] * b0 + mesh.uvs[i1] * b1 + mesh.uvs[i2] * b2
-        };
-        (p, n, ng, uv)
+        let uv = mesh
+            .interpolate(&mesh.uvs, tri, b1, b2)
+            .unwrap_or(Vec2::ZERO);
+        (p, n, ng, uv, tri, Vec2::new(b1, b2))
     }
 }
+
+/// The emission of `program` at barycentrics `b` of triangle `tri` of `mesh`.
+#[inline]
+fn radiance(scene: &Scene, program: &Program, mesh: &Mesh, tri: u32, b: Vec2) -> Vec3 {
+    if program.is_empty() {
+        return program.emission(&ShaderGlobals::at(Vec3::ZERO, Vec3::Z, Vec2::ZERO), &ENV0);
+    }
+    let p = mesh
+        .interpolate(&mesh.positions, tri, b.x, b.y)
+        .unwrap_or(Vec3::ZERO);
+    let ng = triangle_cross(mesh, tri as usize).normalize_or_zero();
+    let n = mesh.shading_normal(tri, b.x, b.y).unwrap_or(ng);
+    let uv = mesh
+        .interpolate(&mesh.uvs, tri, b.x, b.y)
+        .unwrap_or(Vec2::ZERO);
+    let mut g = ShaderGlobals::at(p, n, uv);
+    g.ng = to_blender(ng);
+    g.mesh = Some(mesh);
+    g.tri = tri;
+    g.b1 = b.x;
+    g.b2 = b.y;
+    let env = ShadeEnv {
+        images: &scene.images,
+        textures: &scene.textures,
+        camera_to_world: Mat4::IDENTITY,
+    };
+    program.emission(&g, &env)
+}
+
+const ENV0: ShadeEnv<'static> = ShadeEnv {
+    images: &[],
+    textures: &[],
+    camera_to_world: Mat4::IDENTITY,
+};
 
 impl Emitter for AreaEmitter {
     #[inline]
     fn sample(&self, scene: &Scene, rec: &mut EmitterQueryRecord, u: Vec2) -> Vec3 {
         let mesh = &scene.meshes[self.mesh];
-        let (p, n, ng, uv) = self.sample_point(mesh, u);
+        let (p, n, ng, uv, tri, bary) = self.sample_point(mesh, u);
         let d = p - rec.ref_p;
         let dist2 = d.length_squared();
         if dist2 <= 0.0 || !dist2.is_finite() {
@@ -150,6 +211,8 @@ impl Emitter for AreaEmitter {
         rec.n = n;
         rec.ng = ng;
         rec.uv = uv;
+        rec.tri = tri;
+        rec.bary = bary;
         rec.wi = d / dist;
         rec.dist = dist;
         rec.pdf = self.pdf(scene, rec);
@@ -165,7 +228,7 @@ impl Emitter for AreaEmitter {
         if !self.two_sided && cos <= 0.0 {
             return Vec3::ZERO;
         }
-        self.radiance_at(scene, rec.uv)
+        self.radiance_at(scene, rec)
     }
 
     #[inline]

@@ -34,6 +34,9 @@ pub struct EmitterQueryRecord {
     pub ng: Vec3,
     /// Texture coordinates at `p`.
     pub uv: Vec2,
+    /// Triangle and barycentrics `(b1, b2)` of `p` on an emissive mesh.
+    pub tri: u32,
+    pub bary: Vec2,
     /// Unit direction from `ref_p` towards the emitter.
     pub wi: Vec3,
     /// Distance from `ref_p` to `p` (`f32::INFINITY` for lights at infinity).
@@ -61,6 +64,8 @@ impl EmitterQueryRecord {
             n,
             ng,
             uv,
+            tri: 0,
+            bary: Vec2::ZERO,
             wi: d / dist,
             dist,
             pdf: 0.0,

@@ -21,7 +21,7 @@ impl Integrator for Normals {
 impl Integrator for Albedo {
     fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
         match scene.trace(ctx, o, d, 1) {
-            Some(its) => scene.surface_params(&its).base_color,
+            Some(its) => scene.albedo(ctx, &its, d),
             None => Vec3::ZERO,
         }
     }

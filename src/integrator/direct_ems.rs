@@ -26,7 +26,9 @@ impl Integrator for DirectEms {
             if depth >= self.max_depth {
                 return l;
             }
-            let sp = ShadingPoint::new(scene, ctx, &its, d);
+            let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
+                return l;
+            };
             if !sp.bsdf_is_delta() {
                 return l + throughput * sample_emitter(scene, ctx, &its, &sp, d, false);
             }

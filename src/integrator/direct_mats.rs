@@ -26,7 +26,9 @@ impl Integrator for DirectMats {
             if depth >= self.max_depth {
                 return l;
             }
-            let sp = ShadingPoint::new(scene, ctx, &its, d);
+            let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
+                return l;
+            };
             let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
                 return l;
             };

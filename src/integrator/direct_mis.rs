@@ -28,7 +28,9 @@ impl Integrator for DirectMis {
             if depth >= self.max_depth {
                 return l;
             }
-            let sp = ShadingPoint::new(scene, ctx, &its, d);
+            let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
+                return l;
+            };
             if !sp.bsdf_is_delta() {
                 l += throughput * sample_emitter(scene, ctx, &its, &sp, d, true);
             }

@@ -53,25 +53,46 @@ pub struct ShadingPoint {
     pub frame: Frame,
     /// Local direction towards the previous vertex.
     pub wi: Vec3,
+    /// The chosen closure's weight divided by the probability of choosing it.
+    pub weight: Vec3,
 }
 
 impl ShadingPoint {
-    /// Chooses the BSDF (one random number) and sets up the frame. Opaque surfaces shade
-    /// both faces (the frame is flipped towards the viewer); transmissive ones keep the
-    /// normal's side to tell entering from leaving.
-    pub fn new(scene: &RenderScene, ctx: &mut Ctx, its: &Intersection, d: Vec3) -> Self {
-        let params = scene.surface_params(its);
-        let bsdf = bsdf::choose(&params, ctx.sampler.next_1d());
-        let mut n = its.ns;
-        if !bsdf.is_transmissive() && n.dot(-d) < 0.0 {
+    /// Evaluates the material at the hit (path vertex `depth`), chooses one closure and its
+    /// BSDF (one random number for both) and sets up the frame. Opaque surfaces shade both
+    /// faces (the frame is flipped towards the viewer); transmissive ones keep the normal's
+    /// outward side to tell entering from leaving. `None` when nothing scatters there.
+    pub fn new(
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        its: &Intersection,
+        d: Vec3,
+        depth: u32,
+    ) -> Option<Self> {
+        let u = ctx.sampler.next_1d();
+        let (closure, inv_p, u) = scene.choose_closure(ctx, its, d, depth, u)?;
+        let bsdf = bsdf::from_closure(&closure, u);
+        // The closure's normal faces the viewer (Cycles' N); zero means the shading normal.
+        let mut n = if closure.normal == Vec3::ZERO {
+            its.ns
+        } else {
+            closure.normal
+        };
+        if bsdf.is_transmissive() {
+            // Outward side: the side of the interpolated normal.
+            if n.dot(its.ns) < 0.0 {
+                n = -n;
+            }
+        } else if n.dot(-d) < 0.0 {
             n = -n;
         }
         let frame = Frame::from_normal(n);
-        ShadingPoint {
+        Some(ShadingPoint {
             bsdf,
             wi: frame.to_local(-d),
             frame,
-        }
+            weight: closure.weight * inv_p,
+        })
     }
 
     /// True when the chosen BSDF is purely specular.
@@ -88,7 +109,25 @@ impl ShadingPoint {
         if !self.bsdf.is_transmissive() && its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
             return Vec3::ZERO;
         }
-        self.bsdf.eval(&BsdfQueryRecord::pair(self.wi, lo)) * lo.z.abs()
+        self.bsdf.eval(&BsdfQueryRecord::pair(self.wi, lo)) * lo.z.abs() * self.weight
+    }
+
+    /// Light Path bits of a ray sampled from this point.
+    #[inline]
+    fn ray_flags(&self, rec: &BsdfQueryRecord, reflect: bool) -> u32 {
+        use crate::shading::globals::ray;
+        let kind = if rec.measure == bsdf::Measure::Discrete {
+            ray::GLOSSY | ray::SINGULAR
+        } else if matches!(self.bsdf, BsdfInstance::Diffuse(_)) {
+            ray::DIFFUSE
+        } else {
+            ray::GLOSSY
+        };
+        kind | if reflect {
+            ray::REFLECTION
+        } else {
+            ray::TRANSMISSION
+        }
     }
 
     /// BSDF density of world direction `wo` (per steradian).
@@ -109,13 +148,14 @@ impl ShadingPoint {
         let mut rec = BsdfQueryRecord::new(self.wi);
         let u = ctx.sampler.next_2d();
         let u1 = ctx.sampler.next_1d();
-        let w = self.bsdf.sample(&mut rec, u, u1);
+        let w = self.bsdf.sample(&mut rec, u, u1) * self.weight;
         if w == Vec3::ZERO || !w.is_finite() {
             return None;
         }
         let wo = self.frame.to_world(rec.wo);
         // A reflection must leave on the viewer's side of the true surface.
         let reflect = rec.wo.z * self.wi.z > 0.0;
+        ctx.ray_flags = self.ray_flags(&rec, reflect);
         if reflect && its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
             return None;
         }

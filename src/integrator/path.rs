@@ -48,7 +48,9 @@ impl Integrator for PathMats {
             if depth >= self.max_depth || !roulette(ctx, depth, &mut throughput) {
                 return l;
             }
-            let sp = ShadingPoint::new(scene, ctx, &its, d);
+            let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
+                return l;
+            };
             let Some((wo, w, _)) = sp.sample(ctx, &its, d) else {
                 return l;
             };
@@ -84,7 +86,9 @@ impl Integrator for PathMis {
             if depth >= self.max_depth || !roulette(ctx, depth, &mut throughput) {
                 return l;
             }
-            let sp = ShadingPoint::new(scene, ctx, &its, d);
+            let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
+                return l;
+            };
             if !sp.bsdf_is_delta() {
                 l += throughput * sample_emitter(scene, ctx, &its, &sp, d, true);
             }

@@ -12,6 +12,7 @@ pub mod gltf_write;
 pub use error::{LoadError, LoadErrorKind};
 
 use glam::{Mat4, Vec2, Vec3};
+use std::sync::Arc;
 
 /// A triangle mesh in world space with one material.
 #[derive(Clone, Debug, Default)]
@@ -32,6 +33,119 @@ pub struct Mesh {
     /// Camera rays pass through this mesh (a Blender light with camera visibility off);
     /// every other ray sees it.
     pub hidden_from_camera: bool,
+    /// What shading reads beyond positions, normals and the first UV set.
+    pub attrs: MeshAttributes,
+}
+
+/// Per-object data the shading graph can read (Blender's Object Info node).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectInfo {
+    /// Blender's per-object random number in `[0, 1)`.
+    pub random: f32,
+    pub pass_index: f32,
+    pub color: glam::Vec4,
+    /// Object origin, renderer world space.
+    pub location: Vec3,
+}
+
+impl Default for ObjectInfo {
+    fn default() -> Self {
+        ObjectInfo {
+            random: 0.0,
+            pass_index: 0.0,
+            color: glam::Vec4::ONE,
+            location: Vec3::ZERO,
+        }
+    }
+}
+
+/// Vertex attributes and object data beyond the basics; everything may be empty.
+#[derive(Clone, Debug)]
+pub struct MeshAttributes {
+    /// Names of the UV sets: `uv_names[0]` names [`Mesh::uvs`], `uv_names[k]` names
+    /// `extra_uvs[k - 1]` (may be shorter than the sets: unnamed).
+    pub uv_names: Vec<String>,
+    /// UV sets 1, 2, ... (glTF convention: `(0, 0)` is the image's top-left corner).
+    pub extra_uvs: Vec<Vec<Vec2>>,
+    /// Vertex colours (linear RGBA), with their names.
+    pub colors: Vec<(String, Vec<glam::Vec4>)>,
+    /// Per-vertex tangents, world space: `xyz` unit tangent along +u, `w` the bitangent sign
+    /// (MikkTSpace, for UV set 0). Empty when the mesh has none.
+    pub tangents: Vec<glam::Vec4>,
+    /// World → object space (the space of the node's mesh data).
+    pub to_object: Mat4,
+    /// Texture space (Generated coordinates): `(location, size)` in object space; generated
+    /// coordinates are `(p_object - location) / size · ½ + ½`.
+    pub texspace: Option<(Vec3, Vec3)>,
+    pub object: ObjectInfo,
+}
+
+impl Default for MeshAttributes {
+    fn default() -> Self {
+        MeshAttributes {
+            uv_names: Vec::new(),
+            extra_uvs: Vec::new(),
+            colors: Vec::new(),
+            tangents: Vec::new(),
+            to_object: Mat4::IDENTITY,
+            texspace: None,
+            object: ObjectInfo::default(),
+        }
+    }
+}
+
+impl Mesh {
+    /// The three vertex indices of triangle `tri`.
+    #[inline]
+    pub fn corners(&self, tri: u32) -> [usize; 3] {
+        self.indices[tri as usize].map(|i| i as usize)
+    }
+
+    /// Barycentric interpolation `a·b0 + b·b1 + c·b2` of a per-vertex attribute at triangle
+    /// `tri` with barycentrics `(b1, b2)`; `None` when the attribute is empty. The one place
+    /// where vertex attributes are interpolated.
+    #[inline]
+    pub fn interpolate<T>(&self, data: &[T], tri: u32, b1: f32, b2: f32) -> Option<T>
+    where
+        T: Copy + std::ops::Mul<f32, Output = T> + std::ops::Add<Output = T>,
+    {
+        if data.is_empty() {
+            return None;
+        }
+        let [i0, i1, i2] = self.corners(tri);
+        let b0 = 1.0 - b1 - b2;
+        Some(data[i0] * b0 + data[i1] * b1 + data[i2] * b2)
+    }
+
+    /// Interpolated unit shading normal, or `None` without vertex normals (or where they cancel).
+    #[inline]
+    pub fn shading_normal(&self, tri: u32, b1: f32, b2: f32) -> Option<Vec3> {
+        let s = self.interpolate(&self.normals, tri, b1, b2)?;
+        let l = s.length();
+        (l > 1e-12 && l.is_finite()).then(|| s / l)
+    }
+
+    /// UV set `set` (glTF convention), zero where the mesh has none.
+    #[inline]
+    pub fn uv(&self, set: usize, tri: u32, b1: f32, b2: f32) -> Vec2 {
+        let data = if set == 0 {
+            &self.uvs[..]
+        } else {
+            self.attrs
+                .extra_uvs
+                .get(set - 1)
+                .map_or(&[][..], |v| &v[..])
+        };
+        self.interpolate(data, tri, b1, b2).unwrap_or(Vec2::ZERO)
+    }
+
+    /// The index of the UV set called `name` (`""`: set 0).
+    pub fn uv_set(&self, name: &str) -> Option<usize> {
+        if name.is_empty() {
+            return Some(0);
+        }
+        self.attrs.uv_names.iter().position(|n| n == name)
+    }
 }
 
 /// How a texture is sampled at a texel boundary.
@@ -43,12 +157,14 @@ pub enum Wrap {
     ClampToEdge,
 }
 
-/// A decoded image: 8-bit RGBA, rows top to bottom (as in PNG/JPEG files).
-#[derive(Clone, Debug)]
+/// A decoded image, rows top to bottom (as in PNG/JPEG files): 8-bit RGBA (`rgba8`), or
+/// linear float RGBA (`float`) for high-dynamic-range and 16-bit data; one of the two is empty.
+#[derive(Clone, Debug, Default)]
 pub struct Image {
     pub width: u32,
     pub height: u32,
     pub rgba8: Vec<[u8; 4]>,
+    pub float: Vec<[f32; 4]>,
 }
 
 /// A texture: an image and how to sample it.
@@ -100,6 +216,9 @@ pub struct Material {
     pub specular_color: Vec3,
     /// glTF `doubleSided`.
     pub double_sided: bool,
+    /// The material's node graph (`TESELA_material_graph`); without one, the renderer shades
+    /// with the glTF metallic-roughness preset graph built from the factors above.
+    pub graph: Option<Arc<crate::shading::Graph>>,
 }
 
 impl Default for Material {
@@ -120,6 +239,7 @@ impl Default for Material {
             specular: 1.0,
             specular_color: Vec3::ONE,
             double_sided: false,
+            graph: None,
         }
     }
 }

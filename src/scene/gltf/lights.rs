@@ -262,6 +262,7 @@ impl<'a> Loader<'a> {
                     hidden_from_camera: !member(t, "visible_camera")
                         .and_then(Value::as_bool)
                         .unwrap_or(true),
+                    attrs: Default::default(),
                 });
             }
             other => {

@@ -47,6 +47,7 @@ pub(crate) fn decode_image(bytes: &[u8]) -> Result<Image, String> {
         width,
         height,
         rgba8,
+        float: Vec::new(),
     })
 }
 
@@ -153,8 +154,13 @@ impl<'a> Loader<'a> {
             .and_then(|e| member(e, "two_sided"))
             .and_then(Value::as_bool)
             .unwrap_or(double_sided);
+        let name = m.name.clone().unwrap_or_else(|| format!("material{gi}"));
+        let graph = match extension(raw, "TESELA_material_graph") {
+            Some(g) => Some(std::sync::Arc::new(self.material_graph(g, gi, &name)?)),
+            None => None,
+        };
         Ok(Material {
-            name: m.name.clone().unwrap_or_else(|| format!("material{gi}")),
+            name,
             base_color,
             base_color_texture,
             metallic: finite_or(pbr.metallic_factor.0, 1.0).clamp(0.0, 1.0),
@@ -168,6 +174,162 @@ impl<'a> Loader<'a> {
             specular: finite_or(specular, 1.0).clamp(0.0, 1.0),
             specular_color,
             double_sided,
+            graph,
+        })
+    }
+
+    /// Parses a `TESELA_material_graph` and resolves its image references. A graph that does
+    /// not parse is an error naming the material; an image that cannot be loaded is too.
+    fn material_graph(
+        &mut self,
+        g: &Value,
+        gi: usize,
+        name: &str,
+    ) -> Result<crate::shading::Graph, LoadError> {
+        let mut graph = crate::shading::Graph::from_json(g).map_err(|e| {
+            invalid(format!(
+                "material {gi} (`{name}`): TESELA_material_graph: {e}"
+            ))
+        })?;
+        for node in &mut graph.nodes {
+            let Some(ii) = node.props.get("image").and_then(Value::as_u64) else {
+                continue;
+            };
+            let ii = ii as usize;
+            let image = self.graph_image(ii).map_err(|e| {
+                LoadError::new(
+                    e.kind,
+                    format!(
+                        "material {gi} (`{name}`), node `{}`: {}",
+                        node.name, e.message
+                    ),
+                )
+            })?;
+            node.image = Some(image);
+        }
+        Ok(graph)
+    }
+
+    /// The scene image of entry `ii` of the root `TESELA_images` list when the file has one,
+    /// else of glTF image `ii`.
+    fn graph_image(&mut self, ii: usize) -> Result<usize, LoadError> {
+        let list = self
+            .raw_root_extension("TESELA_images")
+            .and_then(|e| member(e, "images"))
+            .and_then(Value::as_array);
+        let Some(list) = list else {
+            return self.image(ii);
+        };
+        if let Some(&i) = self.raw_images.get(&ii) {
+            return Ok(i);
+        }
+        let entry = list.get(ii).ok_or_else(|| {
+            invalid(format!(
+                "TESELA_images image {ii} does not exist (the file has {})",
+                list.len()
+            ))
+        })?;
+        let img = self.raw_image(entry, ii)?;
+        self.scene.images.push(img);
+        let idx = self.scene.images.len() - 1;
+        self.raw_images.insert(ii, idx);
+        Ok(idx)
+    }
+
+    /// Decodes one `TESELA_images` entry: raw pixel rows, top to bottom, in a bufferView.
+    fn raw_image(&mut self, e: &Value, ii: usize) -> Result<Image, LoadError> {
+        let label = format!("TESELA_images image {ii}");
+        let dim = |k: &str| -> Result<u32, LoadError> {
+            member(e, k)
+                .and_then(Value::as_u64)
+                .filter(|&v| v > 0 && v <= MAX_IMAGE_SIDE as u64)
+                .map(|v| v as u32)
+                .ok_or_else(|| {
+                    invalid(format!(
+                        "{label}: `{k}` must be an integer in 1..={MAX_IMAGE_SIDE}"
+                    ))
+                })
+        };
+        let (w, h) = (dim("width")?, dim("height")?);
+        let channels = member(e, "channels")
+            .and_then(Value::as_u64)
+            .filter(|c| (1..=4).contains(c))
+            .ok_or_else(|| invalid(format!("{label}: `channels` must be 1 to 4")))?
+            as usize;
+        let comp = member(e, "component")
+            .and_then(Value::as_str)
+            .unwrap_or("u8");
+        let size = match comp {
+            "u8" => 1,
+            "u16" | "f16" => 2,
+            "f32" => 4,
+            other => {
+                return Err(invalid(format!(
+                    "{label}: component `{other}` is not one of u8, u16, f16, f32"
+                )));
+            }
+        };
+        let vi = member(e, "bufferView")
+            .and_then(Value::as_u64)
+            .ok_or_else(|| invalid(format!("{label}: no `bufferView`")))? as usize;
+        let (bytes, _) = self
+            .reader
+            .view(vi, &label)
+            .map_err(|err| LoadError::new(err.kind, format!("{label}: {}", err.message)))?;
+        let n = w as usize * h as usize;
+        let need = n * channels * size;
+        if bytes.len() < need {
+            return Err(invalid(format!(
+                "{label}: bufferView {vi} holds {} bytes, {w}x{h}x{channels} {comp} needs {need}",
+                bytes.len()
+            )));
+        }
+        let value = |i: usize| -> f32 {
+            let b = &bytes[i * size..(i + 1) * size];
+            match comp {
+                "u8" => b[0] as f32 / 255.0,
+                "u16" => u16::from_le_bytes([b[0], b[1]]) as f32 / 65535.0,
+                "f16" => half_to_f32(u16::from_le_bytes([b[0], b[1]])),
+                _ => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+            }
+        };
+        let srgb_bytes = comp == "u8";
+        let mut rgba8 = Vec::new();
+        let mut float = Vec::new();
+        let mut bad = 0usize;
+        for p in 0..n {
+            let mut px = [0.0f32, 0.0, 0.0, 1.0];
+            for (c, out) in px.iter_mut().enumerate().take(channels) {
+                let mut v = value(p * channels + c);
+                if !v.is_finite() {
+                    v = 0.0;
+                    bad += 1;
+                }
+                *out = v;
+            }
+            if channels < 3 {
+                px[1] = px[0];
+                px[2] = px[0];
+                if channels == 2 {
+                    px[3] = value(p * channels + 1);
+                }
+            }
+            if srgb_bytes {
+                rgba8.push(px.map(|v| (v * 255.0).round().clamp(0.0, 255.0) as u8));
+            } else {
+                float.push(px);
+            }
+        }
+        if bad > 0 {
+            self.warn_once(format!(
+                "{label}: {bad} texel values are not finite and read as 0"
+            ));
+        }
+        Ok(Image {
+            width: w,
+            height: h,
+            rgba8,
+            float,
         })
     }
 
@@ -303,9 +465,42 @@ impl<'a> Loader<'a> {
     }
 }
 
+/// IEEE 754 half → single precision.
+fn half_to_f32(h: u16) -> f32 {
+    let sign = ((h >> 15) as u32) << 31;
+    let exp = ((h >> 10) & 0x1f) as u32;
+    let frac = (h & 0x3ff) as u32;
+    let bits = match (exp, frac) {
+        (0, 0) => sign,
+        (0, f) => {
+            // Subnormal: normalise.
+            let mut e = 127 - 15 + 1;
+            let mut f = f;
+            while f & 0x400 == 0 {
+                f <<= 1;
+                e -= 1;
+            }
+            sign | (e << 23) | ((f & 0x3ff) << 13)
+        }
+        (31, 0) => sign | 0x7f80_0000,
+        (31, f) => sign | 0x7f80_0000 | (f << 13),
+        (e, f) => sign | ((e + 127 - 15) << 23) | (f << 13),
+    };
+    f32::from_bits(bits)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn half_floats() {
+        assert_eq!(half_to_f32(0x3c00), 1.0);
+        assert_eq!(half_to_f32(0xc000), -2.0);
+        assert_eq!(half_to_f32(0x7bff), 65504.0);
+        assert_eq!(half_to_f32(0x0001), 2f32.powi(-24));
+        assert!(half_to_f32(0x7c00).is_infinite());
+    }
 
     #[test]
     fn garbage_images_are_errors() {

@@ -161,6 +161,7 @@ impl<'a> Loader<'a> {
                 indices,
                 material,
                 hidden_from_camera: false,
+                attrs: Default::default(),
             });
         }
         Ok(())

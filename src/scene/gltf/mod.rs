@@ -50,6 +50,8 @@ const SUPPORTED_REQUIRED: &[&str] = &[
     "TESELA_world",
     "TESELA_emission",
     "TESELA_render",
+    "TESELA_material_graph",
+    "TESELA_images",
 ];
 
 /// Extensions that are used without a warning (`KHR_texture_transform` is accepted but
@@ -66,6 +68,8 @@ const UNDERSTOOD: &[&str] = &[
     "TESELA_world",
     "TESELA_emission",
     "TESELA_render",
+    "TESELA_material_graph",
+    "TESELA_images",
 ];
 
 /// Loads a `.gltf` or `.glb` file. External files are resolved relative to its folder
@@ -151,6 +155,7 @@ fn load_inner(bytes: &[u8], base_dir: Option<&Path>) -> Result<Scene, LoadError>
         default_material: None,
         textures: HashMap::new(),
         images: HashMap::new(),
+        raw_images: HashMap::new(),
         prim_cache: HashMap::new(),
         warned: HashSet::new(),
         tri_total: 0,
@@ -341,6 +346,8 @@ pub(crate) struct Loader<'a> {
     pub textures: HashMap<usize, usize>,
     /// glTF image index -> scene image index.
     pub images: HashMap<usize, usize>,
+    /// `TESELA_images` index -> scene image index.
+    pub raw_images: HashMap<usize, usize>,
     /// (mesh, primitive) -> local data, for meshes instanced with their default weights.
     pub prim_cache: HashMap<(usize, usize), Option<Rc<LocalPrim>>>,
     pub warned: HashSet<String>,
@@ -388,6 +395,11 @@ impl<'a> Loader<'a> {
             .and_then(|a| a.as_array())
             .and_then(|a| a.get(i))
             .unwrap_or(&NULL)
+    }
+
+    /// A root-level extension object of the raw document.
+    pub(crate) fn raw_root_extension(&self, ext: &str) -> Option<&'a Value> {
+        extension(self.raw, ext)
     }
 
     fn root_extensions(&mut self) -> Result<(), LoadError> {

@@ -1,0 +1,174 @@
+//! What a material's program produces at a shading point: weighted BSDF closures, emission and
+//! transparency (Cycles' closure list). Vectors here are in the renderer's world space.
+
+use glam::Vec3;
+
+/// Most BSDF closures one shading point keeps (further ones are dropped with their weight
+/// added to the strongest, as a documented limit).
+pub const MAX_CLOSURES: usize = 8;
+
+/// Blender's Principled BSDF parameters at a point (4.x/5.x meaning).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Principled {
+    pub base_color: Vec3,
+    pub metallic: f32,
+    pub roughness: f32,
+    pub ior: f32,
+    /// Specular IOR Level (0.5 = the IOR's own reflectance; 0 = no specular layer).
+    pub specular_level: f32,
+    pub specular_tint: Vec3,
+    pub transmission: f32,
+    pub anisotropic: f32,
+    pub anisotropic_rotation: f32,
+    pub coat_weight: f32,
+    pub coat_roughness: f32,
+    pub coat_ior: f32,
+    pub coat_tint: Vec3,
+    /// Unit coat normal, world space.
+    pub coat_normal: Vec3,
+    pub sheen_weight: f32,
+    pub sheen_roughness: f32,
+    pub sheen_tint: Vec3,
+    pub subsurface_weight: f32,
+    pub subsurface_radius: Vec3,
+    pub subsurface_scale: f32,
+}
+
+/// One BSDF closure's kind and parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ClosureKind {
+    Principled(Principled),
+    /// Lambert (Oren–Nayar roughness is not modelled yet).
+    Diffuse {
+        color: Vec3,
+    },
+    /// Microfacet reflection without Fresnel (Blender's Glossy/Anisotropic BSDF).
+    Glossy {
+        color: Vec3,
+        roughness: f32,
+        anisotropy: f32,
+        rotation: f32,
+    },
+    /// Dielectric reflection and refraction (Blender's Glass BSDF).
+    Glass {
+        color: Vec3,
+        roughness: f32,
+        ior: f32,
+    },
+    /// Dielectric refraction only (Blender's Refraction BSDF).
+    Refraction {
+        color: Vec3,
+        roughness: f32,
+        ior: f32,
+    },
+    /// Lambertian transmission.
+    Translucent {
+        color: Vec3,
+    },
+    /// Straight pass-through.
+    Transparent {
+        color: Vec3,
+    },
+}
+
+/// A closure with its weight (the product of the mix factors above it and the node's own
+/// weight) and its shading normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Closure {
+    pub weight: Vec3,
+    /// Unit shading normal, world space, on the side the ray came from (as Cycles' `N`).
+    pub normal: Vec3,
+    /// Unit tangent (world space) for anisotropic lobes; zero when the mesh has none.
+    pub tangent: Vec3,
+    pub kind: ClosureKind,
+}
+
+/// Everything a shading point's program produced.
+#[derive(Clone, Debug)]
+pub struct ClosureSet {
+    pub closures: [Closure; MAX_CLOSURES],
+    pub len: usize,
+    /// Emitted radiance, W/(m² sr) (sum of emission closures times their weights).
+    pub emission: Vec3,
+}
+
+const EMPTY: Closure = Closure {
+    weight: Vec3::ZERO,
+    normal: Vec3::Z,
+    tangent: Vec3::ZERO,
+    kind: ClosureKind::Diffuse { color: Vec3::ZERO },
+};
+
+impl Default for ClosureSet {
+    fn default() -> Self {
+        ClosureSet {
+            closures: [EMPTY; MAX_CLOSURES],
+            len: 0,
+            emission: Vec3::ZERO,
+        }
+    }
+}
+
+impl ClosureSet {
+    pub fn clear(&mut self) {
+        self.len = 0;
+        self.emission = Vec3::ZERO;
+    }
+
+    /// The closures present.
+    pub fn closures(&self) -> &[Closure] {
+        &self.closures[..self.len]
+    }
+
+    /// Adds a BSDF closure; zero or non-finite weights are dropped. Past [`MAX_CLOSURES`], the
+    /// closure's weight goes to the strongest kept one (energy kept, lobe shape lost).
+    pub fn push(&mut self, c: Closure) {
+        if c.weight.max_element() <= 0.0 || !c.weight.is_finite() {
+            return;
+        }
+        if self.len < MAX_CLOSURES {
+            self.closures[self.len] = c;
+            self.len += 1;
+        } else if let Some(s) = self
+            .closures
+            .iter_mut()
+            .max_by(|a, b| a.weight.element_sum().total_cmp(&b.weight.element_sum()))
+        {
+            s.weight += c.weight;
+        }
+    }
+
+    pub fn add_emission(&mut self, e: Vec3) {
+        if e.is_finite() {
+            self.emission += e.max(Vec3::ZERO);
+        }
+    }
+
+    /// Chooses closure `i` with probability proportional to the mean of its weight, reusing
+    /// `u` (returned rescaled to `[0, 1)` for the closure's own choices). `None` when there is
+    /// no closure. With one closure, `u` is returned unchanged.
+    #[inline]
+    pub fn choose(&self, u: f32) -> Option<(usize, f32, f32)> {
+        match self.len {
+            0 => None,
+            1 => Some((0, 1.0, u)),
+            n => {
+                let total: f32 = self.closures[..n]
+                    .iter()
+                    .map(|c| c.weight.element_sum())
+                    .sum();
+                let mut acc = 0.0;
+                for (i, c) in self.closures[..n].iter().enumerate() {
+                    let w = c.weight.element_sum();
+                    if u * total < acc + w || i == n - 1 {
+                        let p = w / total;
+                        let r = ((u * total - acc) / w).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+                        return Some((i, p, r));
+                    }
+                    acc += w;
+                }
+                None
+            }
+        }
+    }
+}

@@ -1,0 +1,469 @@
+//! Graph → [`Program`]: nodes are compiled depth-first from the material output, each once
+//! (its outputs get slots), with Cycles' implicit conversions between socket types. Shader
+//! sockets are compiled with a weight: a Mix Shader splits its weight between its inputs, so
+//! every closure node becomes one closure operation carrying the product of the factors above
+//! it (Cycles' closure weights).
+//!
+//! Nothing is dropped silently: a node the renderer does not implement is evaluated as Blender
+//! evaluates a muted node (its internal links, else zero) and reported once in `warnings`,
+//! naming the material and the node.
+
+use super::closure::ClosureSet;
+use super::graph::{Graph, Input};
+use super::nodes;
+use super::program::{Op, Program, Slot};
+use glam::Vec3;
+use serde_json::Value;
+use std::collections::HashMap;
+
+/// Most slots one program may use.
+pub const MAX_SLOTS: usize = 4096;
+
+/// The type of a socket's value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SocketType {
+    Float,
+    Vector,
+    Color,
+    Shader,
+}
+
+impl SocketType {
+    pub fn width(self) -> usize {
+        match self {
+            SocketType::Float => 1,
+            SocketType::Vector | SocketType::Color => 3,
+            SocketType::Shader => 0,
+        }
+    }
+}
+
+/// A compile error: the graph cannot be turned into a program at all (a cycle, too many slots).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CompileError(pub String);
+
+type Result<T> = std::result::Result<T, CompileError>;
+
+/// A compiled output: its slot and type.
+#[derive(Clone, Copy, Debug)]
+struct Out {
+    slot: Slot,
+    ty: SocketType,
+}
+
+enum State {
+    Compiling,
+    Done(Vec<(String, Out)>),
+}
+
+/// The compiler's state for one graph.
+pub struct Compiler<'g> {
+    graph: &'g Graph,
+    material: &'g str,
+    ops: Vec<Op>,
+    init: Vec<f32>,
+    state: HashMap<usize, State>,
+    consts: HashMap<Vec<u32>, Slot>,
+    warnings: Vec<String>,
+    may_emit: bool,
+    /// Whether any operation depends on the shading point (else the closures are constant).
+    varying: bool,
+}
+
+/// The result of compiling a material.
+pub struct Compiled {
+    pub program: Program,
+    /// Fallbacks taken, one line each, naming the material and the node.
+    pub warnings: Vec<String>,
+}
+
+/// Compiles `graph` of material `material`.
+pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, CompileError> {
+    let mut c = Compiler {
+        graph,
+        material,
+        ops: Vec::new(),
+        init: Vec::new(),
+        state: HashMap::new(),
+        consts: HashMap::new(),
+        warnings: Vec::new(),
+        may_emit: false,
+        varying: false,
+    };
+    if let Some((node, output)) = &graph.surface {
+        let one = c.constant(&[1.0])?;
+        c.shader_link(*node, output, one)?;
+    }
+    if let Some((node, _)) = &graph.displacement {
+        let n = &graph.nodes[*node];
+        c.warn(format!(
+            "material '{}': displacement from node '{}' ({}) is not rendered yet",
+            material, n.name, n.kind
+        ));
+    }
+    let mut program = Program {
+        ops: c.ops,
+        init: c.init,
+        constant: None,
+        may_emit: c.may_emit,
+    };
+    if !c.varying {
+        // Closure operations read only constant slots: run once now.
+        let globals = super::globals::ShaderGlobals::at(Vec3::ZERO, Vec3::Z, glam::Vec2::ZERO);
+        let env = super::globals::ShadeEnv {
+            images: &[],
+            textures: &[],
+            camera_to_world: glam::Mat4::IDENTITY,
+        };
+        let mut scratch = super::program::Scratch::default();
+        program.run(&globals, &env, &mut scratch);
+        let set: ClosureSet = scratch.set.clone();
+        program.may_emit = set.emission.max_element() > 0.0;
+        program.constant = Some(set);
+    }
+    Ok(Compiled {
+        program,
+        warnings: c.warnings,
+    })
+}
+
+impl<'g> Compiler<'g> {
+    fn warn(&mut self, msg: String) {
+        if !self.warnings.contains(&msg) {
+            self.warnings.push(msg);
+        }
+    }
+
+    fn alloc(&mut self, width: usize) -> Result<Slot> {
+        let s = self.init.len();
+        if s + width > MAX_SLOTS {
+            return Err(CompileError(format!(
+                "material '{}': the graph needs more than {MAX_SLOTS} values",
+                self.material
+            )));
+        }
+        self.init.resize(s + width, 0.0);
+        Ok(s as Slot)
+    }
+
+    /// A slot holding `v` (shared between equal constants).
+    pub fn constant(&mut self, v: &[f32]) -> Result<Slot> {
+        let key: Vec<u32> = v.iter().map(|x| x.to_bits()).collect();
+        if let Some(&s) = self.consts.get(&key) {
+            return Ok(s);
+        }
+        let s = self.alloc(v.len())?;
+        self.init[s as usize..s as usize + v.len()].copy_from_slice(v);
+        self.consts.insert(key, s);
+        Ok(s)
+    }
+
+    fn push(&mut self, op: Op, varying: bool) {
+        self.varying |= varying;
+        self.ops.push(op);
+    }
+
+    /// Compiles node `n` (once) and returns its outputs.
+    fn node_outputs(&mut self, n: usize) -> Result<Vec<(String, Out)>> {
+        match self.state.get(&n) {
+            Some(State::Done(outs)) => return Ok(outs.clone()),
+            Some(State::Compiling) => {
+                return Err(CompileError(format!(
+                    "material '{}': the node graph has a cycle through node '{}'",
+                    self.material, self.graph.nodes[n].name
+                )));
+            }
+            None => {}
+        }
+        self.state.insert(n, State::Compiling);
+        let mut cx = NodeCx {
+            c: self,
+            node: n,
+            outs: Vec::new(),
+        };
+        let kind = cx.c.graph.nodes[n].kind.clone();
+        let known = nodes::compile(&kind, &mut cx)?;
+        if !known {
+            cx.mute()?;
+        }
+        let outs = cx.outs;
+        self.state.insert(n, State::Done(outs.clone()));
+        Ok(outs)
+    }
+
+    /// The slot of `output` of node `n`, converted to `want`.
+    fn link(&mut self, n: usize, output: &str, want: SocketType) -> Result<Slot> {
+        let outs = self.node_outputs(n)?;
+        let found = outs.iter().find(|(id, _)| id == output).map(|(_, o)| *o);
+        let Some(o) = found else {
+            let node = &self.graph.nodes[n];
+            let msg = format!(
+                "material '{}': node '{}' ({}) has no output '{}' the renderer computes; it reads as zero",
+                self.material, node.name, node.kind, output
+            );
+            self.warn(msg);
+            return self.constant(&vec![0.0; want.width().max(1)]);
+        };
+        self.convert(o, want)
+    }
+
+    /// Cycles' implicit conversions between socket types.
+    fn convert(&mut self, o: Out, want: SocketType) -> Result<Slot> {
+        use SocketType::*;
+        Ok(match (o.ty, want) {
+            (a, b) if a == b => o.slot,
+            (Vector, Color) | (Color, Vector) => o.slot,
+            (Float, Vector | Color) => {
+                let out = self.alloc(3)?;
+                self.push(
+                    Op::Convert(nodes::convert::ConvertOp::FloatToVec { a: o.slot, out }),
+                    false,
+                );
+                out
+            }
+            (Color, Float) => {
+                let out = self.alloc(1)?;
+                self.push(
+                    Op::Convert(nodes::convert::ConvertOp::ColorToFloat { a: o.slot, out }),
+                    false,
+                );
+                out
+            }
+            (Vector, Float) => {
+                let out = self.alloc(1)?;
+                self.push(
+                    Op::Convert(nodes::convert::ConvertOp::VectorToFloat { a: o.slot, out }),
+                    false,
+                );
+                out
+            }
+            (Shader, _) | (_, Shader) => self.constant(&vec![0.0; want.width().max(1)])?,
+            _ => o.slot,
+        })
+    }
+
+    /// Compiles what feeds a shader socket with weight slot `w`: a closure node, or a colour
+    /// (which Cycles turns into an emission closure).
+    fn shader_link(&mut self, n: usize, output: &str, w: Slot) -> Result<()> {
+        let kind = self.graph.nodes[n].kind.clone();
+        if nodes::bsdf::is_shader_node(&kind) {
+            if matches!(self.state.get(&n), Some(State::Compiling)) {
+                return Err(CompileError(format!(
+                    "material '{}': the node graph has a cycle through node '{}'",
+                    self.material, self.graph.nodes[n].name
+                )));
+            }
+            self.state.insert(n, State::Compiling);
+            let mut cx = NodeCx {
+                c: self,
+                node: n,
+                outs: Vec::new(),
+            };
+            let known = nodes::bsdf::compile_closure(&kind, &mut cx, w)?;
+            if !known {
+                // A muted shader node passes its first linked shader input through.
+                let node = &cx.c.graph.nodes[n];
+                let through = node
+                    .internal_links
+                    .iter()
+                    .find(|(o, _)| o == output)
+                    .map(|(_, i)| i.clone());
+                let msg = format!(
+                    "material '{}': shader node '{}' ({}) is not supported; it renders as muted",
+                    cx.c.material, node.name, node.kind
+                );
+                cx.c.warn(msg);
+                if let Some(i) = through {
+                    cx.shader(&i, w)?;
+                }
+            }
+            self.state.remove(&n);
+            return Ok(());
+        }
+        // A value linked into a shader socket: emission of that colour.
+        let color = self.link(n, output, SocketType::Color)?;
+        let one = self.constant(&[1.0])?;
+        let op = nodes::bsdf::ClosureOp::emission(w, color, one);
+        self.may_emit = true;
+        self.push(Op::Closure(op), false);
+        Ok(())
+    }
+}
+
+/// What a node family's compile function sees: the node, its inputs as slots, its outputs.
+pub struct NodeCx<'c, 'g> {
+    c: &'c mut Compiler<'g>,
+    node: usize,
+    outs: Vec<(String, Out)>,
+}
+
+impl<'g> NodeCx<'_, 'g> {
+    pub fn material(&self) -> &'g str {
+        self.c.material
+    }
+
+    pub fn node(&self) -> &'g super::graph::Node {
+        &self.c.graph.nodes[self.node]
+    }
+
+    pub fn is_linked(&self, id: &str) -> bool {
+        matches!(self.node().input(id), Some(Input::Link { .. }))
+    }
+
+    /// Input `id` as a slot of type `ty`: its link, its constant, or `default`.
+    pub fn input(&mut self, id: &str, ty: SocketType, default: &[f32]) -> Result<Slot> {
+        match self.node().input(id) {
+            Some(Input::Link { node, output }) => self.c.link(*node, output, ty),
+            Some(Input::Const(v)) => {
+                let w = ty.width();
+                let mut val = vec![0.0; w];
+                if v.len() == 1 {
+                    val.iter_mut().for_each(|x| *x = v[0]);
+                } else if w == 1 {
+                    // A vector/colour constant in a float socket: Cycles' conversions.
+                    val[0] = match ty {
+                        _ if v.len() >= 3 => {
+                            if self.is_color_default(v) {
+                                luminance(Vec3::new(v[0], v[1], v[2]))
+                            } else {
+                                (v[0] + v[1] + v[2]) / 3.0
+                            }
+                        }
+                        _ => v[0],
+                    };
+                } else {
+                    for (i, x) in val.iter_mut().enumerate() {
+                        *x = v.get(i).copied().unwrap_or(0.0);
+                    }
+                }
+                self.c.constant(&val)
+            }
+            None => {
+                let w = ty.width();
+                let mut val = vec![0.0; w];
+                for (i, x) in val.iter_mut().enumerate() {
+                    *x = default.get(i).or(default.first()).copied().unwrap_or(0.0);
+                }
+                self.c.constant(&val)
+            }
+        }
+    }
+
+    fn is_color_default(&self, v: &[f32]) -> bool {
+        v.len() == 4
+    }
+
+    pub fn float(&mut self, id: &str, default: f32) -> Result<Slot> {
+        self.input(id, SocketType::Float, &[default])
+    }
+
+    pub fn vector(&mut self, id: &str, default: Vec3) -> Result<Slot> {
+        self.input(id, SocketType::Vector, &default.to_array())
+    }
+
+    pub fn color(&mut self, id: &str, default: Vec3) -> Result<Slot> {
+        self.input(id, SocketType::Color, &default.to_array())
+    }
+
+    /// The constant value of input `id` when it is not linked.
+    pub fn const_value(&self, id: &str) -> Option<&'g [f32]> {
+        match self.node().input(id) {
+            Some(Input::Const(v)) => Some(v),
+            _ => None,
+        }
+    }
+
+    /// Declares output `id` of type `ty` and returns its slot.
+    pub fn output(&mut self, id: &str, ty: SocketType) -> Result<Slot> {
+        let slot = self.c.alloc(ty.width().max(1))?;
+        self.outs.push((id.to_string(), Out { slot, ty }));
+        Ok(slot)
+    }
+
+    /// Declares output `id` as an alias of an existing slot.
+    pub fn alias(&mut self, id: &str, slot: Slot, ty: SocketType) {
+        self.outs.push((id.to_string(), Out { slot, ty }));
+    }
+
+    pub fn constant(&mut self, v: &[f32]) -> Result<Slot> {
+        self.c.constant(v)
+    }
+
+    pub fn alloc(&mut self, width: usize) -> Result<Slot> {
+        self.c.alloc(width)
+    }
+
+    /// Emits an operation; `varying` when its result depends on the shading point.
+    pub fn emit(&mut self, op: Op, varying: bool) {
+        self.c.push(op, varying);
+    }
+
+    /// Marks the program as possibly emitting.
+    pub fn emits(&mut self) {
+        self.c.may_emit = true;
+    }
+
+    /// Compiles what feeds shader input `id` with weight slot `w` (nothing when unlinked).
+    pub fn shader(&mut self, id: &str, w: Slot) -> Result<()> {
+        if let Some(Input::Link { node, output }) = self.node().input(id) {
+            self.c.shader_link(*node, output, w)?;
+        }
+        Ok(())
+    }
+
+    pub fn prop(&self, key: &str) -> Option<&'g Value> {
+        self.node().props.get(key)
+    }
+
+    pub fn prop_str(&self, key: &str) -> Option<&'g str> {
+        self.prop(key).and_then(Value::as_str)
+    }
+
+    pub fn prop_bool(&self, key: &str, default: bool) -> bool {
+        self.prop(key).and_then(Value::as_bool).unwrap_or(default)
+    }
+
+    pub fn prop_f32(&self, key: &str, default: f32) -> f32 {
+        self.prop(key)
+            .and_then(Value::as_f64)
+            .map(|x| x as f32)
+            .filter(|x| x.is_finite())
+            .unwrap_or(default)
+    }
+
+    /// Reports a fallback once, naming the material and the node.
+    pub fn warn(&mut self, what: &str) {
+        let node = self.node();
+        let msg = format!(
+            "material '{}': node '{}' ({}): {}",
+            self.c.material, node.name, node.kind, what
+        );
+        self.c.warn(msg);
+    }
+
+    /// Evaluates the node as Blender evaluates a muted node (internal links, else zero), and
+    /// reports it.
+    pub fn mute(&mut self) -> Result<()> {
+        let node = self.node();
+        let msg = format!(
+            "material '{}': node '{}' ({}) is not supported; it renders as muted",
+            self.c.material, node.name, node.kind
+        );
+        self.c.warn(msg);
+        for (out, inp) in &node.internal_links {
+            let ty = match node.input(inp) {
+                Some(Input::Const(v)) if v.len() == 1 => SocketType::Float,
+                _ => SocketType::Color,
+            };
+            let s = self.input(inp, ty, &[0.0])?;
+            self.alias(out, s, ty);
+        }
+        Ok(())
+    }
+}
+
+/// Cycles' colour → float conversion: luminance with Rec. 709 coefficients.
+#[inline]
+pub fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126729, 0.7151522, 0.0721750))
+}

@@ -1,0 +1,186 @@
+//! What a material's program reads at a shading point (Cycles' `ShaderData`) and the
+//! scene-wide data it may look up (images, the camera).
+//!
+//! Graph programs work in **Blender's coordinates** (Z up), as the node graph was authored:
+//! positions, normals and directions are converted from the renderer's Y-up world once, here,
+//! and BSDF normals back when the closures are read.
+
+use crate::scene::{Image, Mesh, Texture};
+use glam::{Mat4, Vec2, Vec3, Vec4};
+
+/// Renderer world (glTF, Y up) → Blender world (Z up).
+#[inline(always)]
+pub fn to_blender(v: Vec3) -> Vec3 {
+    Vec3::new(v.x, -v.z, v.y)
+}
+
+/// Blender world (Z up) → renderer world (glTF, Y up).
+#[inline(always)]
+pub fn from_blender(v: Vec3) -> Vec3 {
+    Vec3::new(v.x, v.z, -v.y)
+}
+
+/// Bits of [`ShaderGlobals::ray_flags`]: what kind of ray reached the point (Light Path node).
+pub mod ray {
+    pub const CAMERA: u32 = 1;
+    pub const SHADOW: u32 = 2;
+    pub const DIFFUSE: u32 = 4;
+    pub const GLOSSY: u32 = 8;
+    pub const SINGULAR: u32 = 16;
+    pub const REFLECTION: u32 = 32;
+    pub const TRANSMISSION: u32 = 64;
+}
+
+/// Scene data a program may look up.
+#[derive(Clone, Copy)]
+pub struct ShadeEnv<'a> {
+    pub images: &'a [Image],
+    pub textures: &'a [Texture],
+    /// Camera to world, Blender coordinates (the camera looks down its local -Z).
+    pub camera_to_world: Mat4,
+}
+
+/// A shading point. Vectors in Blender's world space unless said otherwise.
+#[derive(Clone, Copy)]
+pub struct ShaderGlobals<'a> {
+    pub p: Vec3,
+    /// Unit shading normal, flipped to the side the ray came from (Cycles' `N`).
+    pub n: Vec3,
+    /// Unit geometric normal, on the same side as `n`.
+    pub ng: Vec3,
+    /// Unit direction from the point towards the ray's origin (Cycles' `I`).
+    pub i: Vec3,
+    /// The ray met the back of the surface (the side its geometric normal points away from).
+    pub backfacing: bool,
+    /// The mesh, triangle and barycentrics `(b1, b2)` of the point, when on a mesh.
+    pub mesh: Option<&'a Mesh>,
+    pub tri: u32,
+    pub b1: f32,
+    pub b2: f32,
+    /// UV set 0 at the point, glTF convention (already interpolated).
+    pub uv0: Vec2,
+    /// Path vertex index of the point (1 = seen from the camera).
+    pub ray_depth: u32,
+    pub ray_flags: u32,
+}
+
+impl<'a> ShaderGlobals<'a> {
+    /// A point with only position, normal and UV (tests, emitters without mesh data).
+    pub fn at(p: Vec3, n: Vec3, uv0: Vec2) -> ShaderGlobals<'static> {
+        let (p, n) = (to_blender(p), to_blender(n));
+        ShaderGlobals {
+            p,
+            n,
+            ng: n,
+            i: n,
+            backfacing: false,
+            mesh: None,
+            tri: 0,
+            b1: 0.0,
+            b2: 0.0,
+            uv0,
+            ray_depth: 1,
+            ray_flags: ray::CAMERA,
+        }
+    }
+
+    /// UV set `set` in glTF's convention (`(0, 0)` top-left).
+    #[inline]
+    pub fn uv_gltf(&self, set: usize) -> Vec2 {
+        if set == 0 {
+            return self.uv0;
+        }
+        match self.mesh {
+            Some(m) => m.uv(set, self.tri, self.b1, self.b2),
+            None => Vec2::ZERO,
+        }
+    }
+
+    /// A UV map by name (`""`: the first) in Blender's convention: `(u, 1 - v_glTF, 0)`.
+    #[inline]
+    pub fn uv_named(&self, name: &str) -> Vec3 {
+        let set = self.mesh.and_then(|m| m.uv_set(name)).unwrap_or(0);
+        let uv = self.uv_gltf(set);
+        Vec3::new(uv.x, 1.0 - uv.y, 0.0)
+    }
+
+    /// A colour attribute by name (`""`: the first), linear RGBA; black without one.
+    pub fn color_attribute(&self, name: &str) -> Option<Vec4> {
+        let m = self.mesh?;
+        let set = if name.is_empty() {
+            m.attrs.colors.first()
+        } else {
+            m.attrs.colors.iter().find(|(n, _)| n == name)
+        }?;
+        m.interpolate(&set.1, self.tri, self.b1, self.b2)
+    }
+
+    /// Position in object space (the object's own coordinates, as the add-on wrote them).
+    #[inline]
+    pub fn object_position(&self) -> Vec3 {
+        match self.mesh {
+            Some(m) => m.attrs.to_object.transform_point3(from_blender(self.p)),
+            None => self.p,
+        }
+    }
+
+    /// World → object transform for directions (unnormalised).
+    #[inline]
+    pub fn object_direction(&self, v: Vec3) -> Vec3 {
+        match self.mesh {
+            Some(m) => m.attrs.to_object.transform_vector3(from_blender(v)),
+            None => v,
+        }
+    }
+
+    /// Blender's Generated coordinates: the object-space position normalised to the texture
+    /// space (the mesh's bounds unless the add-on says otherwise).
+    pub fn generated(&self) -> Vec3 {
+        let po = self.object_position();
+        let Some(m) = self.mesh else { return po };
+        match m.attrs.texspace {
+            Some((loc, size)) => {
+                let s = Vec3::select(size.cmpeq(Vec3::ZERO), Vec3::ONE, size);
+                (po - loc) / s * 0.5 + Vec3::splat(0.5)
+            }
+            None => po,
+        }
+    }
+
+    /// Unit tangent (along +u of UV set 0) and bitangent sign, Blender world space: the mesh's
+    /// vertex tangents when it has them, else the triangle's `dp/du`.
+    pub fn tangent(&self) -> Option<(Vec3, f32)> {
+        let m = self.mesh?;
+        if let Some(t) = m.interpolate(&m.attrs.tangents, self.tri, self.b1, self.b2) {
+            let v = to_blender(t.truncate());
+            let l = v.length();
+            if l > 1e-12 && l.is_finite() {
+                return Some((v / l, if t.w < 0.0 { -1.0 } else { 1.0 }));
+            }
+        }
+        // dp/du from the triangle (glTF uv: v runs down, Blender's up).
+        if m.uvs.is_empty() {
+            return None;
+        }
+        let [i0, i1, i2] = m.corners(self.tri);
+        let (p0, p1, p2) = (m.positions[i0], m.positions[i1], m.positions[i2]);
+        let (t0, t1, t2) = (m.uvs[i0], m.uvs[i1], m.uvs[i2]);
+        let (du1, dv1) = (t1.x - t0.x, t0.y - t1.y);
+        let (du2, dv2) = (t2.x - t0.x, t0.y - t2.y);
+        let det = du1 * dv2 - du2 * dv1;
+        if det.abs() < 1e-20 {
+            return None;
+        }
+        let dpdu = ((p1 - p0) * dv2 - (p2 - p0) * dv1) / det;
+        let dpdv = ((p2 - p0) * du1 - (p1 - p0) * du2) / det;
+        let ng = (p1 - p0).cross(p2 - p0);
+        let sign = if ng.cross(dpdu).dot(dpdv) < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        let v = to_blender(dpdu);
+        let l = v.length();
+        (l > 1e-20 && l.is_finite()).then(|| (v / l, sign))
+    }
+}

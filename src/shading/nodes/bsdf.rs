@@ -1,0 +1,417 @@
+//! Shader nodes: BSDFs, emission, and the Mix/Add Shader nodes that weight them.
+
+use crate::shading::closure::{Closure, ClosureKind, ClosureSet, Principled};
+use crate::shading::compile::{CompileError, NodeCx, SocketType};
+use crate::shading::globals::{ShaderGlobals, from_blender};
+use crate::shading::program::{Op, Slot, Slots};
+use glam::Vec3;
+
+/// Node types whose outputs are closures.
+pub fn is_shader_node(kind: &str) -> bool {
+    kind.starts_with("ShaderNodeBsdf")
+        || matches!(
+            kind,
+            "ShaderNodeEmission"
+                | "ShaderNodeMixShader"
+                | "ShaderNodeAddShader"
+                | "ShaderNodeHoldout"
+                | "ShaderNodeBackground"
+                | "ShaderNodeSubsurfaceScattering"
+                | "ShaderNodeEeveeSpecular"
+                | "ShaderNodeVolumeAbsorption"
+                | "ShaderNodeVolumeScatter"
+                | "ShaderNodeVolumePrincipled"
+                | "ShaderNodeGroup"
+        )
+}
+
+/// Principled BSDF inputs as slots.
+#[derive(Clone, Copy, Debug)]
+pub struct PrincipledSlots {
+    base: Slot,
+    metallic: Slot,
+    roughness: Slot,
+    ior: Slot,
+    alpha: Slot,
+    normal: Option<Slot>,
+    specular_level: Slot,
+    specular_tint: Slot,
+    transmission: Slot,
+    anisotropic: Slot,
+    anisotropic_rotation: Slot,
+    tangent: Option<Slot>,
+    coat_weight: Slot,
+    coat_roughness: Slot,
+    coat_ior: Slot,
+    coat_tint: Slot,
+    coat_normal: Option<Slot>,
+    sheen_weight: Slot,
+    sheen_roughness: Slot,
+    sheen_tint: Slot,
+    subsurface_weight: Slot,
+    subsurface_radius: Slot,
+    subsurface_scale: Slot,
+    emission_color: Slot,
+    emission_strength: Slot,
+}
+
+/// A closure node's inputs.
+#[derive(Clone, Debug)]
+pub enum ClosureParams {
+    Principled(Box<PrincipledSlots>),
+    Diffuse {
+        color: Slot,
+        normal: Option<Slot>,
+    },
+    Glossy {
+        color: Slot,
+        roughness: Slot,
+        anisotropy: Slot,
+        rotation: Slot,
+        normal: Option<Slot>,
+        tangent: Option<Slot>,
+    },
+    Glass {
+        color: Slot,
+        roughness: Slot,
+        ior: Slot,
+        normal: Option<Slot>,
+        refraction_only: bool,
+    },
+    Translucent {
+        color: Slot,
+        normal: Option<Slot>,
+    },
+    Transparent {
+        color: Slot,
+    },
+    Emission {
+        color: Slot,
+        strength: Slot,
+    },
+    /// Mix Shader weights: `out1 = w (1 - clamp(fac)), out2 = w clamp(fac)`.
+    MixWeights {
+        fac: Slot,
+        out1: Slot,
+        out2: Slot,
+    },
+}
+
+/// One closure (or weight) operation, with the weight slot of its place in the shader tree.
+#[derive(Clone, Debug)]
+pub struct ClosureOp {
+    weight: Slot,
+    params: ClosureParams,
+}
+
+impl ClosureOp {
+    pub fn emission(weight: Slot, color: Slot, strength: Slot) -> ClosureOp {
+        ClosureOp {
+            weight,
+            params: ClosureParams::Emission { color, strength },
+        }
+    }
+
+    #[inline]
+    pub fn eval(&self, s: &mut Slots, g: &ShaderGlobals, out: &mut ClosureSet) {
+        let w = s.f(self.weight);
+        if let ClosureParams::MixWeights { fac, out1, out2 } = &self.params {
+            let (fac, out1, out2) = (*fac, *out1, *out2);
+            let f = s.f(fac).clamp(0.0, 1.0);
+            s.set_f(out1, w * (1.0 - f));
+            s.set_f(out2, w * f);
+            return;
+        }
+        if w == 0.0 {
+            return;
+        }
+        let normal =
+            |n: Option<Slot>| -> Vec3 { n.map_or(Vec3::ZERO, |n| world_normal(s.v(n), g)) };
+        let tangent = |t: Option<Slot>| -> Vec3 {
+            t.map_or(Vec3::ZERO, |t| {
+                let v = from_blender(s.v(t));
+                let l = v.length();
+                if l > 1e-12 && l.is_finite() {
+                    v / l
+                } else {
+                    Vec3::ZERO
+                }
+            })
+        };
+        let col = |c: Slot| s.v(c).max(Vec3::ZERO);
+        let push = |out: &mut ClosureSet, weight: Vec3, normal: Vec3, tangent: Vec3, kind| {
+            out.push(Closure {
+                weight,
+                normal,
+                tangent,
+                kind,
+            })
+        };
+        match &self.params {
+            ClosureParams::Principled(p) => {
+                let alpha = s.f(p.alpha).clamp(0.0, 1.0);
+                let wb = w * alpha;
+                if alpha < 1.0 {
+                    push(
+                        out,
+                        Vec3::splat(w * (1.0 - alpha)),
+                        Vec3::ZERO,
+                        Vec3::ZERO,
+                        ClosureKind::Transparent { color: Vec3::ONE },
+                    );
+                }
+                out.add_emission(col(p.emission_color) * s.f(p.emission_strength) * wb);
+                let pr = Principled {
+                    base_color: col(p.base),
+                    metallic: s.f(p.metallic).clamp(0.0, 1.0),
+                    roughness: s.f(p.roughness).clamp(0.0, 1.0),
+                    ior: {
+                        let ior = s.f(p.ior);
+                        if ior.is_finite() && ior > 0.0 {
+                            ior
+                        } else {
+                            1.5
+                        }
+                    },
+                    specular_level: s.f(p.specular_level).max(0.0),
+                    specular_tint: col(p.specular_tint),
+                    transmission: s.f(p.transmission).clamp(0.0, 1.0),
+                    anisotropic: s.f(p.anisotropic).clamp(-1.0, 1.0),
+                    anisotropic_rotation: s.f(p.anisotropic_rotation),
+                    coat_weight: s.f(p.coat_weight).max(0.0),
+                    coat_roughness: s.f(p.coat_roughness).clamp(0.0, 1.0),
+                    coat_ior: s.f(p.coat_ior).max(1.0),
+                    coat_tint: col(p.coat_tint),
+                    coat_normal: normal(p.coat_normal),
+                    sheen_weight: s.f(p.sheen_weight).max(0.0),
+                    sheen_roughness: s.f(p.sheen_roughness).clamp(0.0, 1.0),
+                    sheen_tint: col(p.sheen_tint),
+                    subsurface_weight: s.f(p.subsurface_weight).clamp(0.0, 1.0),
+                    subsurface_radius: col(p.subsurface_radius),
+                    subsurface_scale: s.f(p.subsurface_scale).max(0.0),
+                };
+                push(
+                    out,
+                    Vec3::splat(wb),
+                    normal(p.normal),
+                    tangent(p.tangent),
+                    ClosureKind::Principled(pr),
+                );
+            }
+            ClosureParams::Diffuse { color, normal: n } => {
+                let c = col(*color);
+                push(
+                    out,
+                    c * w,
+                    normal(*n),
+                    Vec3::ZERO,
+                    ClosureKind::Diffuse { color: Vec3::ONE },
+                );
+            }
+            ClosureParams::Glossy {
+                color,
+                roughness,
+                anisotropy,
+                rotation,
+                normal: n,
+                tangent: t,
+            } => push(
+                out,
+                col(*color) * w,
+                normal(*n),
+                tangent(*t),
+                ClosureKind::Glossy {
+                    color: Vec3::ONE,
+                    roughness: s.f(*roughness).clamp(0.0, 1.0),
+                    anisotropy: s.f(*anisotropy).clamp(-1.0, 1.0),
+                    rotation: s.f(*rotation),
+                },
+            ),
+            ClosureParams::Glass {
+                color,
+                roughness,
+                ior,
+                normal: n,
+                refraction_only,
+            } => {
+                let (color, roughness, ior) = (
+                    col(*color),
+                    s.f(*roughness).clamp(0.0, 1.0),
+                    s.f(*ior).clamp(1e-3, 1e3),
+                );
+                let kind = if *refraction_only {
+                    ClosureKind::Refraction {
+                        color,
+                        roughness,
+                        ior,
+                    }
+                } else {
+                    ClosureKind::Glass {
+                        color,
+                        roughness,
+                        ior,
+                    }
+                };
+                push(out, Vec3::splat(w), normal(*n), Vec3::ZERO, kind);
+            }
+            ClosureParams::Translucent { color, normal: n } => push(
+                out,
+                col(*color) * w,
+                normal(*n),
+                Vec3::ZERO,
+                ClosureKind::Translucent { color: Vec3::ONE },
+            ),
+            ClosureParams::Transparent { color } => push(
+                out,
+                col(*color) * w,
+                Vec3::ZERO,
+                Vec3::ZERO,
+                ClosureKind::Transparent { color: Vec3::ONE },
+            ),
+            ClosureParams::Emission { color, strength } => {
+                out.add_emission(col(*color) * s.f(*strength) * w);
+            }
+            ClosureParams::MixWeights { .. } => {}
+        }
+    }
+}
+
+/// A linked Normal input (Blender world space) as a unit world-space normal; zero (meaning
+/// "the shading normal") when it is degenerate.
+#[inline]
+fn world_normal(n: Vec3, _g: &ShaderGlobals) -> Vec3 {
+    let v = from_blender(n);
+    let l = v.length();
+    if l > 1e-12 && l.is_finite() {
+        v / l
+    } else {
+        Vec3::ZERO
+    }
+}
+
+/// Compiles closure node `kind` with weight slot `w`; `Ok(false)` when not implemented.
+pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, CompileError> {
+    let normal = |cx: &mut NodeCx, id: &str| -> Result<Option<Slot>, CompileError> {
+        if cx.is_linked(id) {
+            cx.vector(id, Vec3::ZERO).map(Some)
+        } else {
+            Ok(None)
+        }
+    };
+    let params = match kind {
+        "ShaderNodeMixShader" => {
+            let fac = cx.float("Fac", 0.5)?;
+            let out1 = cx.alloc(1)?;
+            let out2 = cx.alloc(1)?;
+            cx.emit(
+                Op::Closure(ClosureOp {
+                    weight: w,
+                    params: ClosureParams::MixWeights { fac, out1, out2 },
+                }),
+                false,
+            );
+            cx.shader("Shader", out1)?;
+            cx.shader("Shader_001", out2)?;
+            return Ok(true);
+        }
+        "ShaderNodeAddShader" => {
+            cx.shader("Shader", w)?;
+            cx.shader("Shader_001", w)?;
+            return Ok(true);
+        }
+        "ShaderNodeBsdfPrincipled" => {
+            let f = |cx: &mut NodeCx, id: &str, d: f32| cx.float(id, d);
+            let c = |cx: &mut NodeCx, id: &str, d: Vec3| cx.color(id, d);
+            let p = PrincipledSlots {
+                base: c(cx, "Base Color", Vec3::splat(0.8))?,
+                metallic: f(cx, "Metallic", 0.0)?,
+                roughness: f(cx, "Roughness", 0.5)?,
+                ior: f(cx, "IOR", 1.5)?,
+                alpha: f(cx, "Alpha", 1.0)?,
+                normal: normal(cx, "Normal")?,
+                specular_level: f(cx, "Specular IOR Level", 0.5)?,
+                specular_tint: c(cx, "Specular Tint", Vec3::ONE)?,
+                transmission: f(cx, "Transmission Weight", 0.0)?,
+                anisotropic: f(cx, "Anisotropic", 0.0)?,
+                anisotropic_rotation: f(cx, "Anisotropic Rotation", 0.0)?,
+                tangent: normal(cx, "Tangent")?,
+                coat_weight: f(cx, "Coat Weight", 0.0)?,
+                coat_roughness: f(cx, "Coat Roughness", 0.03)?,
+                coat_ior: f(cx, "Coat IOR", 1.5)?,
+                coat_tint: c(cx, "Coat Tint", Vec3::ONE)?,
+                coat_normal: normal(cx, "Coat Normal")?,
+                sheen_weight: f(cx, "Sheen Weight", 0.0)?,
+                sheen_roughness: f(cx, "Sheen Roughness", 0.5)?,
+                sheen_tint: c(cx, "Sheen Tint", Vec3::ONE)?,
+                subsurface_weight: f(cx, "Subsurface Weight", 0.0)?,
+                subsurface_radius: cx.vector("Subsurface Radius", Vec3::new(1.0, 0.2, 0.1))?,
+                subsurface_scale: f(cx, "Subsurface Scale", 0.05)?,
+                emission_color: c(cx, "Emission Color", Vec3::ONE)?,
+                emission_strength: f(cx, "Emission Strength", 0.0)?,
+            };
+            if cx.is_linked("Emission Strength")
+                || cx
+                    .const_value("Emission Strength")
+                    .is_some_and(|v| v[0] != 0.0)
+            {
+                cx.emits();
+            }
+            for (id, what) in [
+                (
+                    "Subsurface Weight",
+                    "subsurface scattering renders as diffuse",
+                ),
+                ("Sheen Weight", "sheen is not rendered yet"),
+                ("Coat Weight", "the coat layer is not rendered yet"),
+                ("Anisotropic", "anisotropy is not rendered yet"),
+                ("Thin Film Thickness", "thin film is not rendered"),
+            ] {
+                if cx.is_linked(id) || cx.const_value(id).is_some_and(|v| v[0] != 0.0) {
+                    cx.warn(what);
+                }
+            }
+            ClosureParams::Principled(Box::new(p))
+        }
+        "ShaderNodeBsdfDiffuse" => ClosureParams::Diffuse {
+            color: cx.color("Color", Vec3::splat(0.8))?,
+            normal: normal(cx, "Normal")?,
+        },
+        "ShaderNodeBsdfAnisotropic" | "ShaderNodeBsdfGlossy" => ClosureParams::Glossy {
+            color: cx.color("Color", Vec3::splat(0.8))?,
+            roughness: cx.float("Roughness", 0.5)?,
+            anisotropy: cx.float("Anisotropy", 0.0)?,
+            rotation: cx.float("Rotation", 0.0)?,
+            normal: normal(cx, "Normal")?,
+            tangent: normal(cx, "Tangent")?,
+        },
+        "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction" => ClosureParams::Glass {
+            color: cx.color("Color", Vec3::ONE)?,
+            roughness: cx.float("Roughness", 0.0)?,
+            ior: cx.float("IOR", 1.5)?,
+            normal: normal(cx, "Normal")?,
+            refraction_only: kind == "ShaderNodeBsdfRefraction",
+        },
+        "ShaderNodeBsdfTranslucent" => ClosureParams::Translucent {
+            color: cx.color("Color", Vec3::splat(0.8))?,
+            normal: normal(cx, "Normal")?,
+        },
+        "ShaderNodeBsdfTransparent" => ClosureParams::Transparent {
+            color: cx.color("Color", Vec3::ONE)?,
+        },
+        "ShaderNodeEmission" => {
+            cx.emits();
+            ClosureParams::Emission {
+                color: cx.color("Color", Vec3::ONE)?,
+                strength: cx.float("Strength", 1.0)?,
+            }
+        }
+        "ShaderNodeHoldout" => {
+            cx.warn("holdout renders as nothing (no alpha yet)");
+            return Ok(true);
+        }
+        _ => return Ok(false),
+    };
+    cx.emit(Op::Closure(ClosureOp { weight: w, params }), false);
+    let _ = SocketType::Shader;
+    Ok(true)
+}

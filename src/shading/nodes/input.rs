@@ -1,0 +1,351 @@
+//! Input nodes: what the shading point knows (Texture Coordinate, UV Map, Geometry, Object
+//! Info, Light Path, Layer Weight, Fresnel, attributes) and constant Value/RGB nodes.
+
+use crate::shading::compile::{CompileError, NodeCx, SocketType};
+use crate::shading::globals::{ShadeEnv, ShaderGlobals, ray, to_blender};
+use crate::shading::program::{Op, Slot, Slots};
+use glam::{Vec2, Vec3};
+
+/// Which value of the shading point an [`InputOp`] writes.
+#[derive(Clone, Debug)]
+pub enum Source {
+    Generated,
+    /// Object-space normal.
+    ObjectNormal,
+    /// A UV map by name (Blender convention), `""` = the first.
+    Uv(String),
+    /// UV set `n` in glTF's convention (the glTF preset graph's texture coordinates).
+    GltfUv(usize),
+    Object,
+    Camera,
+    Reflection,
+    Position,
+    Normal,
+    TrueNormal,
+    Incoming,
+    Tangent,
+    Parametric,
+    Backfacing,
+    ObjectLocation,
+    ObjectColor,
+    ObjectAlpha,
+    ObjectIndex,
+    ObjectRandom,
+    /// Light Path flag bit.
+    RayFlag(u32),
+    RayDepth,
+    /// Colour attribute by name: `(name, alpha?)`.
+    Color(String, bool),
+    /// A geometry attribute by name: a UV map (Blender convention) or a colour attribute.
+    Attribute(String, AttrPart),
+    /// Layer Weight (`fresnel` output or `facing`), blend slot, optional normal slot.
+    LayerWeight {
+        fresnel: bool,
+        blend: Slot,
+        normal: Option<Slot>,
+    },
+    /// Fresnel node: IOR slot, optional normal slot.
+    Fresnel {
+        ior: Slot,
+        normal: Option<Slot>,
+    },
+}
+
+/// Which part of an attribute the Attribute node's output carries.
+#[derive(Clone, Copy, Debug)]
+pub enum AttrPart {
+    Rgb,
+    /// Cycles' Fac: the mean of the three components.
+    Average,
+    Alpha,
+}
+
+#[derive(Clone, Debug)]
+pub struct InputOp {
+    pub src: Source,
+    pub out: Slot,
+}
+
+/// Dielectric Fresnel reflectance for cosine `cosi` and relative IOR `eta` (Cycles'
+/// `fresnel_dielectric_cos`).
+#[inline]
+pub fn fresnel_dielectric_cos(cosi: f32, eta: f32) -> f32 {
+    let c = cosi.abs();
+    let g = eta * eta - 1.0 + c * c;
+    if g > 0.0 {
+        let g = g.sqrt();
+        let a = (g - c) / (g + c);
+        let b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+        0.5 * a * a * (1.0 + b * b)
+    } else {
+        1.0
+    }
+}
+
+fn unit_or(v: Vec3, fallback: Vec3) -> Vec3 {
+    let l = v.length();
+    if l > 1e-12 && l.is_finite() {
+        v / l
+    } else {
+        fallback
+    }
+}
+
+impl InputOp {
+    #[inline]
+    pub fn eval(&self, s: &mut Slots, g: &ShaderGlobals, env: &ShadeEnv) {
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        let info = g.mesh.map(|m| &m.attrs.object);
+        match &self.src {
+            Source::Generated => s.set_v(self.out, g.generated()),
+            Source::ObjectNormal => s.set_v(self.out, unit_or(g.object_direction(g.n), g.n)),
+            Source::Uv(name) => s.set_v(self.out, g.uv_named(name)),
+            Source::GltfUv(set) => {
+                let uv: Vec2 = g.uv_gltf(*set);
+                s.set_v(self.out, uv.extend(0.0));
+            }
+            Source::Object => s.set_v(self.out, g.object_position()),
+            Source::Camera => {
+                let p = env.camera_to_world.inverse().transform_point3(g.p);
+                s.set_v(self.out, p);
+            }
+            Source::Reflection => s.set_v(self.out, 2.0 * g.n.dot(g.i) * g.n - g.i),
+            Source::Position => s.set_v(self.out, g.p),
+            Source::Normal => s.set_v(self.out, g.n),
+            Source::TrueNormal => s.set_v(self.out, g.ng),
+            Source::Incoming => s.set_v(self.out, g.i),
+            Source::Tangent => s.set_v(self.out, g.tangent().map_or(Vec3::ZERO, |t| t.0)),
+            Source::Parametric => s.set_v(self.out, Vec3::new(1.0 - g.b1 - g.b2, g.b1, 0.0)),
+            Source::Backfacing => s.set_f(self.out, flag(g.backfacing)),
+            Source::ObjectLocation => s.set_v(
+                self.out,
+                to_blender(info.map_or(Vec3::ZERO, |o| o.location)),
+            ),
+            Source::ObjectColor => {
+                s.set_v(self.out, info.map_or(Vec3::ONE, |o| o.color.truncate()))
+            }
+            Source::ObjectAlpha => s.set_f(self.out, info.map_or(1.0, |o| o.color.w)),
+            Source::ObjectIndex => s.set_f(self.out, info.map_or(0.0, |o| o.pass_index)),
+            Source::ObjectRandom => s.set_f(self.out, info.map_or(0.0, |o| o.random)),
+            Source::RayFlag(bit) => s.set_f(self.out, flag(g.ray_flags & bit != 0)),
+            Source::RayDepth => s.set_f(self.out, g.ray_depth.saturating_sub(1) as f32),
+            Source::Color(name, alpha) => {
+                let c = g.color_attribute(name).unwrap_or(glam::Vec4::ZERO);
+                if *alpha {
+                    s.set_f(self.out, c.w);
+                } else {
+                    s.set_v(self.out, c.truncate());
+                }
+            }
+            Source::Attribute(name, part) => {
+                let is_uv = g
+                    .mesh
+                    .is_some_and(|m| m.attrs.uv_names.iter().any(|n| n == name));
+                let v = if is_uv {
+                    g.uv_named(name).extend(1.0)
+                } else {
+                    g.color_attribute(name).unwrap_or(glam::Vec4::ZERO)
+                };
+                match part {
+                    AttrPart::Rgb => s.set_v(self.out, v.truncate()),
+                    AttrPart::Average => s.set_f(self.out, (v.x + v.y + v.z) / 3.0),
+                    AttrPart::Alpha => s.set_f(self.out, v.w),
+                }
+            }
+            Source::LayerWeight {
+                fresnel,
+                blend,
+                normal,
+            } => {
+                let n = normal.map_or(g.n, |n| unit_or(s.v(n), g.n));
+                let b = s.f(*blend);
+                let cos = g.i.dot(n);
+                let f = if *fresnel {
+                    let eta = (1.0 - b).max(1e-5);
+                    let eta = if g.backfacing { eta } else { 1.0 / eta };
+                    fresnel_dielectric_cos(cos, eta)
+                } else {
+                    let b = b.clamp(0.0, 1.0 - 1e-5);
+                    let mut f = cos.abs();
+                    if b != 0.5 {
+                        let e = if b < 0.5 { 2.0 * b } else { 0.5 / (1.0 - b) };
+                        f = f.powf(e);
+                    }
+                    1.0 - f
+                };
+                s.set_f(self.out, f);
+            }
+            Source::Fresnel { ior, normal } => {
+                let n = normal.map_or(g.n, |n| unit_or(s.v(n), g.n));
+                let eta = s.f(*ior).max(1e-5);
+                let eta = if g.backfacing { 1.0 / eta } else { eta };
+                s.set_f(self.out, fresnel_dielectric_cos(g.i.dot(n), eta));
+            }
+        }
+    }
+}
+
+fn emit(cx: &mut NodeCx, id: &str, ty: SocketType, src: Source) -> Result<(), CompileError> {
+    let out = cx.output(id, ty)?;
+    cx.emit(Op::Input(InputOp { src, out }), true);
+    Ok(())
+}
+
+/// Compiles input nodes; `Ok(false)` for other kinds.
+pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
+    use SocketType::{Color, Float, Vector};
+    match kind {
+        "ShaderNodeTexCoord" => {
+            if cx.prop("object").is_some_and(|o| !o.is_null()) {
+                cx.warn(
+                    "texture coordinates from another object are not supported; its own are used",
+                );
+            }
+            emit(cx, "Generated", Vector, Source::Generated)?;
+            emit(cx, "Normal", Vector, Source::ObjectNormal)?;
+            emit(cx, "UV", Vector, Source::Uv(String::new()))?;
+            emit(cx, "Object", Vector, Source::Object)?;
+            emit(cx, "Camera", Vector, Source::Camera)?;
+            emit(cx, "Reflection", Vector, Source::Reflection)?;
+            // Window coordinates need the projection: reported when used.
+            let w = cx.constant(&[0.0, 0.0, 0.0])?;
+            cx.alias("Window", w, Vector);
+        }
+        "TeselaGltfUv" => {
+            let set = cx.prop_f32("set", 0.0).max(0.0) as usize;
+            emit(cx, "UV", Vector, Source::GltfUv(set))?;
+        }
+        "ShaderNodeUVMap" => {
+            if cx.prop_bool("from_instancer", false) {
+                cx.warn("UVs from the instancer are not supported; the mesh's own are used");
+            }
+            let name = cx.prop_str("uv_map").unwrap_or("").to_string();
+            emit(cx, "UV", Vector, Source::Uv(name))?;
+        }
+        "ShaderNodeNewGeometry" => {
+            emit(cx, "Position", Vector, Source::Position)?;
+            emit(cx, "Normal", Vector, Source::Normal)?;
+            emit(cx, "Tangent", Vector, Source::Tangent)?;
+            emit(cx, "True Normal", Vector, Source::TrueNormal)?;
+            emit(cx, "Incoming", Vector, Source::Incoming)?;
+            emit(cx, "Parametric", Vector, Source::Parametric)?;
+            emit(cx, "Backfacing", Float, Source::Backfacing)?;
+            let half = cx.constant(&[0.5])?;
+            cx.alias("Pointiness", half, Float);
+            let zero = cx.constant(&[0.0])?;
+            cx.alias("Random Per Island", zero, Float);
+        }
+        "ShaderNodeObjectInfo" => {
+            emit(cx, "Location", Vector, Source::ObjectLocation)?;
+            emit(cx, "Color", Color, Source::ObjectColor)?;
+            emit(cx, "Alpha", Float, Source::ObjectAlpha)?;
+            emit(cx, "Object Index", Float, Source::ObjectIndex)?;
+            emit(cx, "Random", Float, Source::ObjectRandom)?;
+            let zero = cx.constant(&[0.0])?;
+            cx.alias("Material Index", zero, Float);
+        }
+        "ShaderNodeLightPath" => {
+            for (id, bit) in [
+                ("Is Camera Ray", ray::CAMERA),
+                ("Is Shadow Ray", ray::SHADOW),
+                ("Is Diffuse Ray", ray::DIFFUSE),
+                ("Is Glossy Ray", ray::GLOSSY),
+                ("Is Singular Ray", ray::SINGULAR),
+                ("Is Reflection Ray", ray::REFLECTION),
+                ("Is Transmission Ray", ray::TRANSMISSION),
+            ] {
+                emit(cx, id, Float, Source::RayFlag(bit))?;
+            }
+            emit(cx, "Ray Depth", Float, Source::RayDepth)?;
+            let zero = cx.constant(&[0.0])?;
+            for id in [
+                "Is Volume Scatter Ray",
+                "Ray Length",
+                "Diffuse Depth",
+                "Glossy Depth",
+                "Transparent Depth",
+                "Transmission Depth",
+                "Portal Depth",
+            ] {
+                cx.alias(id, zero, Float);
+            }
+        }
+        "ShaderNodeVertexColor" => {
+            let name = cx.prop_str("layer_name").unwrap_or("").to_string();
+            emit(cx, "Color", Color, Source::Color(name.clone(), false))?;
+            emit(cx, "Alpha", Float, Source::Color(name, true))?;
+        }
+        "ShaderNodeAttribute" => {
+            let name = cx.prop_str("attribute_name").unwrap_or("").to_string();
+            let ty = cx.prop_str("attribute_type").unwrap_or("GEOMETRY");
+            if ty != "GEOMETRY" {
+                cx.warn(
+                    "object/instancer/view-layer attributes are not supported; they read as zero",
+                );
+            }
+            for (id, t, part) in [
+                ("Color", Color, AttrPart::Rgb),
+                ("Vector", Vector, AttrPart::Rgb),
+                ("Fac", Float, AttrPart::Average),
+                ("Alpha", Float, AttrPart::Alpha),
+            ] {
+                emit(cx, id, t, Source::Attribute(name.clone(), part))?;
+            }
+        }
+        "ShaderNodeLayerWeight" => {
+            let blend = cx.float("Blend", 0.5)?;
+            let normal = if cx.is_linked("Normal") {
+                Some(cx.vector("Normal", Vec3::ZERO)?)
+            } else {
+                None
+            };
+            for (id, fresnel) in [("Fresnel", true), ("Facing", false)] {
+                emit(
+                    cx,
+                    id,
+                    Float,
+                    Source::LayerWeight {
+                        fresnel,
+                        blend,
+                        normal,
+                    },
+                )?;
+            }
+        }
+        "ShaderNodeFresnel" => {
+            let ior = cx.float("IOR", 1.5)?;
+            let normal = if cx.is_linked("Normal") {
+                Some(cx.vector("Normal", Vec3::ZERO)?)
+            } else {
+                None
+            };
+            emit(cx, "Fac", Float, Source::Fresnel { ior, normal })?;
+        }
+        "ShaderNodeValue" => {
+            let v = cx.prop_f32("value", 0.5);
+            let s = cx.constant(&[v])?;
+            cx.alias("Value", s, Float);
+        }
+        "ShaderNodeRGB" => {
+            let v: Vec<f32> = cx
+                .prop("value")
+                .and_then(|v| v.as_array())
+                .map(|a| {
+                    a.iter()
+                        .filter_map(|x| x.as_f64())
+                        .map(|x| x as f32)
+                        .collect()
+                })
+                .unwrap_or_else(|| vec![0.5, 0.5, 0.5]);
+            let c = [
+                v.first().copied().unwrap_or(0.5),
+                v.get(1).copied().unwrap_or(0.5),
+                v.get(2).copied().unwrap_or(0.5),
+            ];
+            let s = cx.constant(&c)?;
+            cx.alias("Color", s, Color);
+        }
+        _ => return Ok(false),
+    }
+    Ok(true)
+}

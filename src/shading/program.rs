@@ -1,0 +1,149 @@
+//! A compiled material: a flat list of operations over a slot array (Cycles' SVM is the model:
+//! each operation reads slots and writes slots), run once per shading point without allocating.
+
+use super::closure::ClosureSet;
+use super::globals::{ShadeEnv, ShaderGlobals};
+use super::nodes;
+use glam::Vec3;
+
+/// Index of one `f32` in the slot array; a vector or colour takes three consecutive slots.
+pub type Slot = u16;
+
+/// The slot array and the closures one evaluation fills. One per thread, reused.
+#[derive(Default)]
+pub struct Scratch {
+    pub slots: Vec<f32>,
+    pub set: ClosureSet,
+}
+
+/// Slot access for operations.
+pub struct Slots<'a>(pub &'a mut [f32]);
+
+impl Slots<'_> {
+    #[inline(always)]
+    pub fn f(&self, s: Slot) -> f32 {
+        self.0[s as usize]
+    }
+    #[inline(always)]
+    pub fn v(&self, s: Slot) -> Vec3 {
+        let i = s as usize;
+        Vec3::new(self.0[i], self.0[i + 1], self.0[i + 2])
+    }
+    #[inline(always)]
+    pub fn set_f(&mut self, s: Slot, x: f32) {
+        self.0[s as usize] = x;
+    }
+    #[inline(always)]
+    pub fn set_v(&mut self, s: Slot, x: Vec3) {
+        let i = s as usize;
+        self.0[i] = x.x;
+        self.0[i + 1] = x.y;
+        self.0[i + 2] = x.z;
+    }
+}
+
+/// One operation. Each node family owns its payload type and its evaluation.
+#[derive(Clone, Debug)]
+pub enum Op {
+    Closure(nodes::bsdf::ClosureOp),
+    Input(nodes::input::InputOp),
+    Image(nodes::image::ImageOp),
+    Vector(nodes::vector::VectorOp),
+    Convert(nodes::convert::ConvertOp),
+}
+
+impl Op {
+    #[inline]
+    fn eval(&self, s: &mut Slots, g: &ShaderGlobals, env: &ShadeEnv, out: &mut ClosureSet) {
+        match self {
+            Op::Closure(op) => op.eval(s, g, out),
+            Op::Input(op) => op.eval(s, g, env),
+            Op::Image(op) => op.eval(s, env),
+            Op::Vector(op) => op.eval(s, g),
+            Op::Convert(op) => op.eval(s),
+        }
+    }
+}
+
+/// A compiled material graph.
+#[derive(Clone, Debug, Default)]
+pub struct Program {
+    pub(crate) ops: Vec<Op>,
+    /// Initial slot values (constants; outputs start at 0).
+    pub(crate) init: Vec<f32>,
+    /// The closures, when they do not depend on the shading point (then `ops` is not run).
+    pub(crate) constant: Option<ClosureSet>,
+    /// Whether any emission can come out of the program.
+    pub(crate) may_emit: bool,
+}
+
+impl Program {
+    /// Runs the program at `g`; the result lives in `scratch` or, for constant programs, in
+    /// the program itself.
+    #[inline]
+    pub fn eval<'a>(
+        &'a self,
+        g: &ShaderGlobals,
+        env: &ShadeEnv,
+        scratch: &'a mut Scratch,
+    ) -> &'a ClosureSet {
+        if let Some(c) = &self.constant {
+            return c;
+        }
+        self.run(g, env, scratch);
+        &scratch.set
+    }
+
+    /// Runs the operations into `scratch` (even for a constant program).
+    pub(crate) fn run(&self, g: &ShaderGlobals, env: &ShadeEnv, scratch: &mut Scratch) {
+        scratch.slots.clear();
+        scratch.slots.extend_from_slice(&self.init);
+        scratch.set.clear();
+        let mut s = Slots(&mut scratch.slots);
+        for op in &self.ops {
+            op.eval(&mut s, g, env, &mut scratch.set);
+        }
+    }
+
+    /// Emission at a point (for emitters, which shade without a per-thread context).
+    pub fn emission(&self, g: &ShaderGlobals, env: &ShadeEnv) -> Vec3 {
+        if let Some(c) = &self.constant {
+            return c.emission;
+        }
+        if !self.may_emit {
+            return Vec3::ZERO;
+        }
+        SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            self.run(g, env, &mut s);
+            s.set.emission
+        })
+    }
+
+    /// True when the program may emit light somewhere.
+    pub fn may_emit(&self) -> bool {
+        self.may_emit
+    }
+
+    /// Number of operations run per shading point (0 for constant programs).
+    pub fn len(&self) -> usize {
+        if self.constant.is_some() {
+            0
+        } else {
+            self.ops.len()
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
+}
+
+/// Runs `f` with this thread's scratch space.
+pub fn with_scratch<R>(f: impl FnOnce(&mut Scratch) -> R) -> R {
+    SCRATCH.with(|s| f(&mut s.borrow_mut()))
+}
