@@ -53,7 +53,9 @@ struct Out {
 
 enum State {
     Compiling,
-    Done(Vec<(String, Out)>),
+    /// Compiled, with its outputs; `partial` when only the outputs asked for so far were
+    /// computed (another output compiles the node again).
+    Done(Vec<(String, Out)>, bool),
 }
 
 /// The compiler's state for one graph.
@@ -163,10 +165,17 @@ impl<'g> Compiler<'g> {
         self.ops.push(op);
     }
 
-    /// Compiles node `n` (once) and returns its outputs.
-    fn node_outputs(&mut self, n: usize) -> Result<Vec<(String, Out)>> {
+    /// Compiles node `n` (once, or again for an output a partial compile left out) and
+    /// returns its outputs; `wanted` is the output being asked for.
+    fn node_outputs(&mut self, n: usize, wanted: &str) -> Result<Vec<(String, Out)>> {
+        let mut before = Vec::new();
         match self.state.get(&n) {
-            Some(State::Done(outs)) => return Ok(outs.clone()),
+            Some(State::Done(outs, partial)) => {
+                if !*partial || outs.iter().any(|(id, _)| id == wanted) {
+                    return Ok(outs.clone());
+                }
+                before = outs.clone();
+            }
             Some(State::Compiling) => {
                 return Err(CompileError(format!(
                     "material '{}': the node graph has a cycle through node '{}'",
@@ -180,20 +189,24 @@ impl<'g> Compiler<'g> {
             c: self,
             node: n,
             outs: Vec::new(),
+            wanted: Some(wanted.to_string()),
+            partial: false,
         };
         let kind = cx.c.graph.nodes[n].kind.clone();
         let known = nodes::compile(&kind, &mut cx)?;
         if !known {
             cx.mute()?;
         }
-        let outs = cx.outs;
-        self.state.insert(n, State::Done(outs.clone()));
+        let partial = cx.partial;
+        let mut outs = before;
+        outs.extend(cx.outs);
+        self.state.insert(n, State::Done(outs.clone(), partial));
         Ok(outs)
     }
 
     /// The slot of `output` of node `n`, converted to `want`.
     fn link(&mut self, n: usize, output: &str, want: SocketType) -> Result<Slot> {
-        let outs = self.node_outputs(n)?;
+        let outs = self.node_outputs(n, output)?;
         let found = outs.iter().find(|(id, _)| id == output).map(|(_, o)| *o);
         let Some(o) = found else {
             let node = &self.graph.nodes[n];
@@ -258,6 +271,8 @@ impl<'g> Compiler<'g> {
                 c: self,
                 node: n,
                 outs: Vec::new(),
+                wanted: None,
+                partial: false,
             };
             let known = nodes::bsdf::compile_closure(&kind, &mut cx, w)?;
             if !known {
@@ -295,6 +310,8 @@ pub struct NodeCx<'c, 'g> {
     c: &'c mut Compiler<'g>,
     node: usize,
     outs: Vec<(String, Out)>,
+    wanted: Option<String>,
+    partial: bool,
 }
 
 impl<'g> NodeCx<'_, 'g> {
@@ -304,6 +321,17 @@ impl<'g> NodeCx<'_, 'g> {
 
     pub fn node(&self) -> &'g super::graph::Node {
         &self.c.graph.nodes[self.node]
+    }
+
+    /// The output being asked for (`None` for shader nodes).
+    pub fn wanted(&self) -> Option<&str> {
+        self.wanted.as_deref()
+    }
+
+    /// Declares that only some outputs were compiled: asking for another one compiles the
+    /// node again for it.
+    pub fn partial(&mut self) {
+        self.partial = true;
     }
 
     pub fn is_linked(&self, id: &str) -> bool {
@@ -462,8 +490,8 @@ impl<'g> NodeCx<'_, 'g> {
     }
 }
 
-/// Cycles' colour → float conversion: luminance with Rec. 709 coefficients.
+/// Cycles' colour → float conversion: luminance with the scene's (OCIO) Rec. 709 weights.
 #[inline]
 pub fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126729, 0.7151522, 0.0721750))
+    super::nodes::color::rgb_to_bw(c)
 }

@@ -50,6 +50,8 @@ pub enum Op {
     Image(nodes::image::ImageOp),
     Vector(nodes::vector::VectorOp),
     Convert(nodes::convert::ConvertOp),
+    Texture(nodes::texture::TextureOp),
+    Utility(nodes::utility::UtilityOp),
 }
 
 impl Op {
@@ -61,6 +63,8 @@ impl Op {
             Op::Image(op) => op.eval(s, env),
             Op::Vector(op) => op.eval(s, g),
             Op::Convert(op) => op.eval(s),
+            Op::Texture(op) => op.eval(s),
+            Op::Utility(op) => op.eval(s),
         }
     }
 }

@@ -95,44 +95,18 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             let out = cx.output("Vector", Vector)?;
             cx.emit(Op::Convert(ConvertOp::Combine { x, y, z, out }), false);
         }
-        "ShaderNodeSeparateColor" | "ShaderNodeSeparateRGB"
-            if cx.prop_str("mode").unwrap_or("RGB") == "RGB" =>
-        {
-            let id = if cx.node().input("Color").is_some() || kind == "ShaderNodeSeparateColor" {
-                "Color"
-            } else {
-                "Image"
-            };
-            let a = cx.color(id, Vec3::splat(0.8))?;
-            let (rx, gx, bx) = if kind == "ShaderNodeSeparateRGB" {
-                ("R", "G", "B")
-            } else {
-                ("Red", "Green", "Blue")
-            };
-            let x = cx.output(rx, Float)?;
-            let y = cx.output(gx, Float)?;
-            let z = cx.output(bx, Float)?;
+        "ShaderNodeSeparateRGB" => {
+            let a = cx.color("Image", Vec3::splat(0.8))?;
+            let x = cx.output("R", Float)?;
+            let y = cx.output("G", Float)?;
+            let z = cx.output("B", Float)?;
             cx.emit(Op::Convert(ConvertOp::Separate { a, x, y, z }), false);
         }
-        "ShaderNodeCombineColor" | "ShaderNodeCombineRGB"
-            if cx.prop_str("mode").unwrap_or("RGB") == "RGB" =>
-        {
-            let (rx, gx, bx) = if kind == "ShaderNodeCombineRGB" {
-                ("R", "G", "B")
-            } else {
-                ("Red", "Green", "Blue")
-            };
-            let x = cx.float(rx, 0.0)?;
-            let y = cx.float(gx, 0.0)?;
-            let z = cx.float(bx, 0.0)?;
-            let out = cx.output(
-                if kind == "ShaderNodeCombineRGB" {
-                    "Image"
-                } else {
-                    "Color"
-                },
-                Color,
-            )?;
+        "ShaderNodeCombineRGB" => {
+            let x = cx.float("R", 0.0)?;
+            let y = cx.float("G", 0.0)?;
+            let z = cx.float("B", 0.0)?;
+            let out = cx.output("Image", Color)?;
             cx.emit(Op::Convert(ConvertOp::Combine { x, y, z, out }), false);
         }
         "TeselaMultiply" => {

@@ -1,10 +1,19 @@
 //! Node families: each file compiles its nodes into operations and evaluates them.
 
 pub mod bsdf;
+pub mod color;
 pub mod convert;
+pub mod curves;
 pub mod image;
 pub mod input;
+pub mod map_range;
+pub mod math;
+pub mod mix;
+pub mod ramp;
+pub mod texture;
+pub mod utility;
 pub mod vector;
+pub mod vector_math;
 
 use super::compile::{CompileError, NodeCx};
 
@@ -13,6 +22,8 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
     for family in [
         input::compile,
         image::compile,
+        texture::compile,
+        utility::compile,
         vector::compile,
         convert::compile,
     ] {
