@@ -7,6 +7,7 @@ use crate::emitter::{
     LightChoice, LightSampler, PointLight, SpotLight,
 };
 use crate::frame::Frame;
+use crate::integrator::MAX_TRANSPARENT;
 use crate::scene::{Light, Scene};
 use crate::shading::globals::{ShadeEnv, ShaderGlobals, to_blender};
 use crate::shading::{ClosureKind, Program};
@@ -143,6 +144,8 @@ pub struct RenderScene {
     pub scene: Scene,
     /// Each material's compiled shading program (indexed like `scene.materials`).
     pub programs: Vec<Arc<Program>>,
+    /// Some material may be transparent: shadow rays and last path segments look through.
+    passes: bool,
     /// The camera in Blender's coordinates, for the graph's Camera coordinates.
     camera_to_world: Mat4,
     accel: Accel,
@@ -253,8 +256,10 @@ impl RenderScene {
         let powers: Vec<f32> = emitters.iter().map(|e| e.power(&scene, radius)).collect();
         let lights = LightSampler::new(&powers, choice);
         scene.warnings.extend(warnings);
+        let passes = programs.iter().any(|p| p.may_pass());
         RenderScene {
             scene,
+            passes,
             programs,
             camera_to_world,
             accel,
@@ -287,6 +292,9 @@ impl RenderScene {
     /// background costs no scene traversal at all. Not for camera rays (hidden meshes).
     #[inline]
     pub fn emission_along(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Emitted {
+        if self.passes {
+            return self.emission_through(ctx, o, d);
+        }
         let Some(emissive) = &self.emitter_accel else {
             return self.emission_at(self.intersect(ctx, o, d).as_ref(), o, d);
         };
@@ -309,6 +317,98 @@ impl RenderScene {
             return None;
         }
         self.background_radiance(d, o)
+    }
+
+    /// [`RenderScene::emission_along`] in a scene with transparent surfaces: the first emission
+    /// or background behind up to [`MAX_TRANSPARENT`] transparent surfaces, times their
+    /// transmittance.
+    fn emission_through(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Emitted {
+        let mut tr = Vec3::ONE;
+        let mut p = o;
+        for _ in 0..=MAX_TRANSPARENT {
+            let hit = self.intersect(ctx, p, d);
+            let (e, le, rec) = match &hit {
+                Some(its) => match self.emitted(its, o) {
+                    Some(x) => x,
+                    None => (0, Vec3::ZERO, EmitterQueryRecord::default()),
+                },
+                None => {
+                    return self
+                        .background_radiance(d, o)
+                        .map(|(e, le, r)| (e, le * tr, r));
+                }
+            };
+            if le != Vec3::ZERO {
+                return Some((e, le * tr, rec));
+            }
+            let its = hit?;
+            tr *= self.transparency(ctx, &its, d);
+            if tr == Vec3::ZERO {
+                return None;
+            }
+            p = offset_origin(its.p, its.ng, d);
+        }
+        None
+    }
+
+    /// The straight-through transmittance of the surface at `its` for a shadow ray along `d`.
+    fn transparency(&self, ctx: &mut Ctx, its: &Intersection, d: Vec3) -> Vec3 {
+        let program = &self.programs[its.material as usize];
+        if !program.may_pass() {
+            return Vec3::ZERO;
+        }
+        let g = self.globals(its, d, 2, crate::shading::globals::ray::SHADOW);
+        program.transparency(&g, &self.shade_env(), &mut ctx.shade)
+    }
+
+    /// The fraction of light from the emitter sample `rec` that reaches surface point `p`
+    /// (geometric normal `ng`): 1 or 0 for opaque scenes, the product of the transparent
+    /// surfaces' transmittance in between otherwise.
+    #[inline]
+    pub fn transmittance(
+        &self,
+        ctx: &mut Ctx,
+        p: Vec3,
+        ng: Vec3,
+        rec: &EmitterQueryRecord,
+    ) -> Vec3 {
+        if !self.passes {
+            return if self.unoccluded(ctx, p, ng, rec) {
+                Vec3::ONE
+            } else {
+                Vec3::ZERO
+            };
+        }
+        let mut o = offset_origin(p, ng, rec.wi);
+        let (d, mut tmax) = if rec.dist.is_finite() {
+            let target = offset_origin(rec.p, rec.ng, -rec.wi);
+            let v = target - o;
+            let dist = v.length();
+            if dist <= 0.0 || !dist.is_finite() {
+                return Vec3::ONE;
+            }
+            (v / dist, dist * (1.0 - 1e-6))
+        } else {
+            (rec.wi, f32::INFINITY)
+        };
+        let mut tr = Vec3::ONE;
+        for _ in 0..=MAX_TRANSPARENT {
+            ctx.cast(o, d, tmax, RayKind::Closest);
+            let Some(hit) = self.accel.intersect_with(&mut ctx.trav, o, d, 0.0, tmax) else {
+                return tr;
+            };
+            let its = self.intersection(&hit, d);
+            tr *= self.transparency(ctx, &its, d);
+            if tr == Vec3::ZERO {
+                return tr;
+            }
+            o = offset_origin(its.p, its.ng, d);
+            tmax -= hit.t;
+            if tmax <= 0.0 {
+                return tr;
+            }
+        }
+        Vec3::ZERO
     }
 
     /// The full intersection record of `hit` (a hit of a ray along `d`).
@@ -422,6 +522,8 @@ impl RenderScene {
             b1: its.b1,
             b2: its.b2,
             uv0: its.uv,
+            // About a tenth of a pixel at a typical field of view.
+            bump_step: its.t.max(1e-3) * 1e-4,
             ray_depth: depth,
             ray_flags: flags,
         }

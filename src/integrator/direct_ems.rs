@@ -2,7 +2,7 @@
 //! surface, one light sample and a shadow ray. Emitters seen directly (or through a chain of
 //! delta bounces) show their radiance.
 
-use super::{Integrator, ShadingPoint, sample_emitter, spawn, trace_emitted};
+use super::{Integrator, MAX_TRANSPARENT, ShadingPoint, sample_emitter, spawn, trace_emitted};
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
 
@@ -15,6 +15,7 @@ impl Integrator for DirectEms {
         let mut l = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
+        let mut transparent = 0;
         loop {
             let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth, depth >= self.max_depth);
             if let Some((_, le, _)) = emitted {
@@ -29,6 +30,17 @@ impl Integrator for DirectEms {
             let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
                 return l;
             };
+            if sp.passes {
+                // Straight through a transparent closure: not a bounce (Cycles counts these
+                // separately, up to its default of 8).
+                transparent += 1;
+                if transparent > MAX_TRANSPARENT {
+                    return l;
+                }
+                throughput *= sp.weight;
+                o = spawn(&its, d);
+                continue;
+            }
             if !sp.bsdf_is_delta() {
                 return l + throughput * sample_emitter(scene, ctx, &its, &sp, d, false);
             }

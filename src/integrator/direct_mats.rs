@@ -1,7 +1,7 @@
 //! Direct illumination by BSDF sampling (the seed's `direct_mats`): one BSDF sample at the
 //! first non-delta surface; its ray counts the radiance of whatever emitter it hits.
 
-use super::{Integrator, ShadingPoint, spawn, trace_emitted};
+use super::{Integrator, MAX_TRANSPARENT, ShadingPoint, spawn, trace_emitted};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
@@ -15,6 +15,7 @@ impl Integrator for DirectMats {
         let mut l = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
+        let mut transparent = 0;
         loop {
             let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth, depth >= self.max_depth);
             if let Some((_, le, _)) = emitted {
@@ -29,6 +30,17 @@ impl Integrator for DirectMats {
             let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
                 return l;
             };
+            if sp.passes {
+                // Straight through a transparent closure: not a bounce (Cycles counts these
+                // separately, up to its default of 8).
+                transparent += 1;
+                if transparent > MAX_TRANSPARENT {
+                    return l;
+                }
+                throughput *= sp.weight;
+                o = spawn(&its, d);
+                continue;
+            }
             let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
                 return l;
             };

@@ -3,7 +3,9 @@
 //! heuristic. Delta BSDF samples and delta lights get weight 1 (the other strategy cannot
 //! produce them). The light-choice probability is part of the emitter density on both sides.
 
-use super::{Integrator, ShadingPoint, mis_weight, sample_emitter, spawn, trace_emitted};
+use super::{
+    Integrator, MAX_TRANSPARENT, ShadingPoint, mis_weight, sample_emitter, spawn, trace_emitted,
+};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
@@ -17,6 +19,7 @@ impl Integrator for DirectMis {
         let mut l = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
+        let mut transparent = 0;
         loop {
             let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth, depth >= self.max_depth);
             if let Some((_, le, _)) = emitted {
@@ -31,6 +34,17 @@ impl Integrator for DirectMis {
             let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
                 return l;
             };
+            if sp.passes {
+                // Straight through a transparent closure: not a bounce (Cycles counts these
+                // separately, up to its default of 8).
+                transparent += 1;
+                if transparent > MAX_TRANSPARENT {
+                    return l;
+                }
+                throughput *= sp.weight;
+                o = spawn(&its, d);
+                continue;
+            }
             if !sp.bsdf_is_delta() {
                 l += throughput * sample_emitter(scene, ctx, &its, &sp, d, true);
             }

@@ -47,8 +47,14 @@ pub fn by_name(name: &str, max_depth: u32) -> Option<Box<dyn Integrator>> {
     })
 }
 
+/// Most transparent surfaces a path or shadow ray goes straight through (Cycles' default
+/// `transparent_max_bounces`).
+pub const MAX_TRANSPARENT: u32 = 8;
+
 /// The BSDF at a hit in its shading frame, with the local direction towards the ray's origin.
 pub struct ShadingPoint {
+    /// The chosen closure is transparent: the ray goes on straight, with `weight`.
+    pub passes: bool,
     pub bsdf: BsdfInstance,
     pub frame: Frame,
     /// Local direction towards the previous vertex.
@@ -88,6 +94,10 @@ impl ShadingPoint {
         }
         let frame = Frame::from_normal(n);
         Some(ShadingPoint {
+            passes: matches!(
+                closure.kind,
+                crate::shading::ClosureKind::Transparent { .. }
+            ),
             bsdf,
             wi: frame.to_local(-d),
             frame,
@@ -194,7 +204,11 @@ pub fn sample_emitter(
         return Vec3::ZERO;
     }
     let f = sp.eval_cos(its, d, rec.wi);
-    if f == Vec3::ZERO || !scene.unoccluded(ctx, its.p, its.ng, &rec) {
+    if f == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let tr = scene.transmittance(ctx, its.p, its.ng, &rec);
+    if tr == Vec3::ZERO {
         return Vec3::ZERO;
     }
     let w = if mis && !scene.is_delta_light(light) {
@@ -202,7 +216,7 @@ pub fn sample_emitter(
     } else {
         1.0
     };
-    f * weight * w
+    f * weight * w * tr
 }
 
 /// Traces the ray leaving path vertex `depth - 1` and returns the surface it hits (if any) with

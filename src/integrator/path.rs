@@ -2,7 +2,9 @@
 //! BSDF sampling at every vertex, power heuristic). Russian roulette from vertex 4 on, on the
 //! throughput's **maximum** component, survival probability capped at 0.95.
 
-use super::{Integrator, ShadingPoint, mis_weight, sample_emitter, spawn, trace_emitted};
+use super::{
+    Integrator, MAX_TRANSPARENT, ShadingPoint, mis_weight, sample_emitter, spawn, trace_emitted,
+};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
@@ -37,6 +39,7 @@ impl Integrator for PathMats {
         let mut l = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
+        let mut transparent = 0;
         loop {
             let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth, depth >= self.max_depth);
             if let Some((_, le, _)) = emitted {
@@ -51,6 +54,17 @@ impl Integrator for PathMats {
             let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
                 return l;
             };
+            if sp.passes {
+                // Straight through a transparent closure: not a bounce (Cycles counts these
+                // separately, up to its default of 8).
+                transparent += 1;
+                if transparent > MAX_TRANSPARENT {
+                    return l;
+                }
+                throughput *= sp.weight;
+                o = spawn(&its, d);
+                continue;
+            }
             let Some((wo, w, _)) = sp.sample(ctx, &its, d) else {
                 return l;
             };
@@ -67,6 +81,7 @@ impl Integrator for PathMis {
         let mut l = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
+        let mut transparent = 0;
         // Density of the BSDF sample that produced the current ray; infinite for camera rays
         // and delta samples (emitter sampling could not have produced them: MIS weight 1).
         let mut bsdf_pdf = f32::INFINITY;
@@ -89,6 +104,17 @@ impl Integrator for PathMis {
             let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
                 return l;
             };
+            if sp.passes {
+                // Straight through a transparent closure: not a bounce (Cycles counts these
+                // separately, up to its default of 8).
+                transparent += 1;
+                if transparent > MAX_TRANSPARENT {
+                    return l;
+                }
+                throughput *= sp.weight;
+                o = spawn(&its, d);
+                continue;
+            }
             if !sp.bsdf_is_delta() {
                 l += throughput * sample_emitter(scene, ctx, &its, &sp, d, true);
             }

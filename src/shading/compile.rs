@@ -64,10 +64,15 @@ pub struct Compiler<'g> {
     material: &'g str,
     ops: Vec<Op>,
     init: Vec<f32>,
-    state: HashMap<usize, State>,
+    /// Per (node, bump context): compiled outputs.
+    state: HashMap<(usize, u8), State>,
+    /// The bump context being compiled: 0 at the point, 1 and 2 at its offsets along the
+    /// two surface directions (a Bump node evaluates its height three times).
+    bump: u8,
     consts: HashMap<Vec<u32>, Slot>,
     warnings: Vec<String>,
     may_emit: bool,
+    may_pass: bool,
     /// Whether any operation depends on the shading point (else the closures are constant).
     varying: bool,
 }
@@ -87,9 +92,11 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
         ops: Vec::new(),
         init: Vec::new(),
         state: HashMap::new(),
+        bump: 0,
         consts: HashMap::new(),
         warnings: Vec::new(),
         may_emit: false,
+        may_pass: false,
         varying: false,
     };
     if let Some((node, output)) = &graph.surface {
@@ -108,6 +115,7 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
         init: c.init,
         constant: None,
         may_emit: c.may_emit,
+        may_pass: c.may_pass,
     };
     if !c.varying {
         // Closure operations read only constant slots: run once now.
@@ -121,6 +129,10 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
         program.run(&globals, &env, &mut scratch);
         let set: ClosureSet = scratch.set.clone();
         program.may_emit = set.emission.max_element() > 0.0;
+        program.may_pass = set
+            .closures()
+            .iter()
+            .any(|c| matches!(c.kind, super::ClosureKind::Transparent { .. }));
         program.constant = Some(set);
     }
     Ok(Compiled {
@@ -169,7 +181,8 @@ impl<'g> Compiler<'g> {
     /// returns its outputs; `wanted` is the output being asked for.
     fn node_outputs(&mut self, n: usize, wanted: &str) -> Result<Vec<(String, Out)>> {
         let mut before = Vec::new();
-        match self.state.get(&n) {
+        let key = (n, self.bump);
+        match self.state.get(&key) {
             Some(State::Done(outs, partial)) => {
                 if !*partial || outs.iter().any(|(id, _)| id == wanted) {
                     return Ok(outs.clone());
@@ -184,7 +197,7 @@ impl<'g> Compiler<'g> {
             }
             None => {}
         }
-        self.state.insert(n, State::Compiling);
+        self.state.insert(key, State::Compiling);
         let mut cx = NodeCx {
             c: self,
             node: n,
@@ -200,7 +213,7 @@ impl<'g> Compiler<'g> {
         let partial = cx.partial;
         let mut outs = before;
         outs.extend(cx.outs);
-        self.state.insert(n, State::Done(outs.clone(), partial));
+        self.state.insert(key, State::Done(outs.clone(), partial));
         Ok(outs)
     }
 
@@ -260,13 +273,14 @@ impl<'g> Compiler<'g> {
     fn shader_link(&mut self, n: usize, output: &str, w: Slot) -> Result<()> {
         let kind = self.graph.nodes[n].kind.clone();
         if nodes::bsdf::is_shader_node(&kind) {
-            if matches!(self.state.get(&n), Some(State::Compiling)) {
+            let key = (n, self.bump);
+            if matches!(self.state.get(&key), Some(State::Compiling)) {
                 return Err(CompileError(format!(
                     "material '{}': the node graph has a cycle through node '{}'",
                     self.material, self.graph.nodes[n].name
                 )));
             }
-            self.state.insert(n, State::Compiling);
+            self.state.insert(key, State::Compiling);
             let mut cx = NodeCx {
                 c: self,
                 node: n,
@@ -292,7 +306,7 @@ impl<'g> Compiler<'g> {
                     cx.shader(&i, w)?;
                 }
             }
-            self.state.remove(&n);
+            self.state.remove(&key);
             return Ok(());
         }
         // A value linked into a shader socket: emission of that colour.
@@ -431,6 +445,11 @@ impl<'g> NodeCx<'_, 'g> {
         self.c.may_emit = true;
     }
 
+    /// Marks the program as possibly letting light straight through (a transparent closure).
+    pub fn passes(&mut self) {
+        self.c.may_pass = true;
+    }
+
     /// Compiles what feeds shader input `id` with weight slot `w` (nothing when unlinked).
     pub fn shader(&mut self, id: &str, w: Slot) -> Result<()> {
         if let Some(Input::Link { node, output }) = self.node().input(id) {
@@ -457,6 +476,24 @@ impl<'g> NodeCx<'_, 'g> {
             .map(|x| x as f32)
             .filter(|x| x.is_finite())
             .unwrap_or(default)
+    }
+
+    /// Compiles input `id` as a float at the two offset points of a Bump node: the slots of
+    /// its value at `P + dPdx` and `P + dPdy` (the operations in between run with the
+    /// shading point moved).
+    pub fn float_at_offsets(&mut self, id: &str, default: f32) -> Result<[Slot; 2]> {
+        let saved = self.c.bump;
+        let mut out = [0; 2];
+        for (i, axis) in [1u8, 2].into_iter().enumerate() {
+            self.c
+                .push(Op::Bump(nodes::bump::BumpOp::Enter { axis }), true);
+            self.c.bump = axis;
+            let r = self.float(id, default);
+            self.c.bump = saved;
+            self.c.push(Op::Bump(nodes::bump::BumpOp::Leave), true);
+            out[i] = r?;
+        }
+        Ok(out)
     }
 
     /// Reports a fallback once, naming the material and the node.

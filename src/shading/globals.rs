@@ -59,6 +59,9 @@ pub struct ShaderGlobals<'a> {
     pub b2: f32,
     /// UV set 0 at the point, glTF convention (already interpolated).
     pub uv0: Vec2,
+    /// World-space size of the offsets a Bump node differentiates over (a small fraction of
+    /// the pixel footprint; Cycles uses ray differentials and a 0.1-pixel filter width).
+    pub bump_step: f32,
     /// Path vertex index of the point (1 = seen from the camera).
     pub ray_depth: u32,
     pub ray_flags: u32,
@@ -79,9 +82,45 @@ impl<'a> ShaderGlobals<'a> {
             b1: 0.0,
             b2: 0.0,
             uv0,
+            bump_step: 1e-4,
             ray_depth: 1,
             ray_flags: ray::CAMERA,
         }
+    }
+
+    /// The two surface directions a Bump node differentiates along (Blender world space,
+    /// orthogonal to `ng`, of length `bump_step`).
+    #[inline]
+    pub fn bump_axes(&self) -> (Vec3, Vec3) {
+        let f = crate::frame::Frame::from_normal(self.ng);
+        (f.s * self.bump_step, f.t * self.bump_step)
+    }
+
+    /// The shading point moved along bump axis 1 or 2: position, barycentrics and UV set 0
+    /// move with it (so every attribute is read at the moved point); the normals stay.
+    pub fn offset(&self, axis: u8) -> ShaderGlobals<'a> {
+        let (dx, dy) = self.bump_axes();
+        let dp = if axis == 1 { dx } else { dy };
+        let mut g = *self;
+        g.p += dp;
+        if let Some(m) = self.mesh {
+            let [i0, i1, i2] = m.corners(self.tri);
+            let (e1, e2) = (
+                m.positions[i1] - m.positions[i0],
+                m.positions[i2] - m.positions[i0],
+            );
+            // dP = db1 e1 + db2 e2 in the triangle's plane (least squares, glTF space).
+            let d = from_blender(dp);
+            let (a, b, c) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+            let (r1, r2) = (d.dot(e1), d.dot(e2));
+            let det = a * c - b * b;
+            if det.abs() > 1e-30 && det.is_finite() {
+                g.b1 += (c * r1 - b * r2) / det;
+                g.b2 += (a * r2 - b * r1) / det;
+                g.uv0 = m.uv(0, g.tri, g.b1, g.b2);
+            }
+        }
+        g
     }
 
     /// UV set `set` in glTF's convention (`(0, 0)` top-left).

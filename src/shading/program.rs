@@ -52,6 +52,7 @@ pub enum Op {
     Convert(nodes::convert::ConvertOp),
     Texture(nodes::texture::TextureOp),
     Utility(nodes::utility::UtilityOp),
+    Bump(nodes::bump::BumpOp),
 }
 
 impl Op {
@@ -65,6 +66,7 @@ impl Op {
             Op::Convert(op) => op.eval(s),
             Op::Texture(op) => op.eval(s),
             Op::Utility(op) => op.eval(s),
+            Op::Bump(op) => op.eval(s, g),
         }
     }
 }
@@ -79,6 +81,9 @@ pub struct Program {
     pub(crate) constant: Option<ClosureSet>,
     /// Whether any emission can come out of the program.
     pub(crate) may_emit: bool,
+    /// Whether a transparent closure can come out of the program (shadow rays must then
+    /// look through the surface).
+    pub(crate) may_pass: bool,
 }
 
 impl Program {
@@ -104,8 +109,15 @@ impl Program {
         scratch.slots.extend_from_slice(&self.init);
         scratch.set.clear();
         let mut s = Slots(&mut scratch.slots);
+        // Bump nodes evaluate their height at offset points: operations between Enter and
+        // Leave see the moved point.
+        let mut moved: Option<ShaderGlobals> = None;
         for op in &self.ops {
-            op.eval(&mut s, g, env, &mut scratch.set);
+            match op {
+                Op::Bump(nodes::bump::BumpOp::Enter { axis }) => moved = Some(g.offset(*axis)),
+                Op::Bump(nodes::bump::BumpOp::Leave) => moved = None,
+                _ => op.eval(&mut s, moved.as_ref().unwrap_or(g), env, &mut scratch.set),
+            }
         }
     }
 
@@ -127,6 +139,25 @@ impl Program {
     /// True when the program may emit light somewhere.
     pub fn may_emit(&self) -> bool {
         self.may_emit
+    }
+
+    /// True when the surface may be partly transparent somewhere.
+    pub fn may_pass(&self) -> bool {
+        self.may_pass
+    }
+
+    /// The straight-through transmittance at a point (the summed weight of the transparent
+    /// closures), for shadow rays.
+    pub fn transparency(&self, g: &ShaderGlobals, env: &ShadeEnv, scratch: &mut Scratch) -> Vec3 {
+        if !self.may_pass {
+            return Vec3::ZERO;
+        }
+        let set = self.eval(g, env, scratch);
+        set.closures()
+            .iter()
+            .filter(|c| matches!(c.kind, super::ClosureKind::Transparent { .. }))
+            .map(|c| c.weight)
+            .sum()
     }
 
     /// Number of operations run per shading point (0 for constant programs).

@@ -349,6 +349,9 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                 emission_color: c(cx, "Emission Color", Vec3::ONE)?,
                 emission_strength: f(cx, "Emission Strength", 0.0)?,
             };
+            if cx.is_linked("Alpha") || cx.const_value("Alpha").is_some_and(|v| v[0] < 1.0) {
+                cx.passes();
+            }
             if cx.is_linked("Emission Strength")
                 || cx
                     .const_value("Emission Strength")
@@ -395,9 +398,12 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
             color: cx.color("Color", Vec3::splat(0.8))?,
             normal: normal(cx, "Normal")?,
         },
-        "ShaderNodeBsdfTransparent" => ClosureParams::Transparent {
-            color: cx.color("Color", Vec3::ONE)?,
-        },
+        "ShaderNodeBsdfTransparent" => {
+            cx.passes();
+            ClosureParams::Transparent {
+                color: cx.color("Color", Vec3::ONE)?,
+            }
+        }
         "ShaderNodeEmission" => {
             cx.emits();
             ClosureParams::Emission {

@@ -1,6 +1,7 @@
 //! Node families: each file compiles its nodes into operations and evaluates them.
 
 pub mod bsdf;
+pub mod bump;
 pub mod color;
 pub mod convert;
 pub mod curves;
@@ -25,6 +26,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         texture::compile,
         utility::compile,
         vector::compile,
+        bump::compile,
         convert::compile,
     ] {
         if family(kind, cx)? {
