@@ -11,6 +11,16 @@ Known breaks handled here:
     versions also accept it flat, so one flat float32 array serves both).
   * 4.4 passes arguments to RenderEngine.__init__ (handled in engine.py by
     always accepting *args, **kwargs).
+  * Shader node vocabulary (translate_node): the material graph always uses
+    5.x node types and socket identifiers. 4.0 rewrote the Principled BSDF
+    (socket renames, coat/sheen/subsurface/specular-tint conversions), merged
+    Anisotropic into Glossy (bl_idname ShaderNodeBsdfAnisotropic), removed the
+    Sharp distribution, turned Velvet into Sheen and renamed the subsurface
+    methods; 4.0/4.1 gave the Noise texture a type and normalize flag and
+    merged Musgrave into it; the legacy MixRGB and Separate/Combine RGB/HSV
+    nodes are written as Mix and Separate/Combine Color in every version.
+    Each conversion follows Blender's own versioning code (versioning_400.cc,
+    versioning_410.cc), including the helper nodes it inserts.
 """
 
 import bpy
@@ -77,6 +87,39 @@ def node_tree(idblock):
     return tree
 
 
+def material_output(tree):
+    """The Material Output node Cycles uses: the active one targeting All or Cycles."""
+    getter = getattr(tree, "get_output_node", None)
+    if getter is not None:
+        try:
+            node = getter("CYCLES")
+        except (TypeError, RuntimeError):
+            node = None
+        if node is not None:
+            return node
+    outputs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
+    cand = [n for n in outputs if n.target in ("ALL", "CYCLES")]
+    for n in cand:
+        if getattr(n, "is_active_output", False):
+            return n
+    return cand[0] if cand else None
+
+
+def displacement_method(material):
+    """'BUMP' | 'DISPLACEMENT' | 'BOTH' (material setting in 4.x+, Cycles setting before)."""
+    value = getattr(material, "displacement_method", None)
+    if value is None:
+        value = getattr(getattr(material, "cycles", None), "displacement_method", None)
+    return value or "BUMP"
+
+
+def socket_available(sock):
+    """Whether a node socket takes part in evaluation (Blender skips unavailable sockets)."""
+    if not getattr(sock, "enabled", True):
+        return False
+    return not getattr(sock, "is_unavailable", False)
+
+
 # --- mesh data ---------------------------------------------------------------
 
 def corner_normals(mesh, n_loops):
@@ -97,24 +140,80 @@ def vertex_positions(mesh, n_verts):
     return out.reshape(-1, 3)
 
 
-def corner_uvs(mesh, n_loops):
-    """Active render UV map per corner, float32 (n_loops, 2), or None."""
-    layers = mesh.uv_layers
-    if not len(layers):
-        return None
-    layer = None
+def uv_layers(mesh):
+    """The mesh's UV maps, the active render one first (glTF set 0), then the others in order."""
+    layers = list(mesh.uv_layers)
+    if not layers:
+        return []
+    first = None
     for uv in layers:
         if getattr(uv, "active_render", False):
-            layer = uv
+            first = uv
             break
-    if layer is None:
-        layer = layers.active or layers[0]
+    if first is None:
+        first = mesh.uv_layers.active or layers[0]
+    return [first] + [uv for uv in layers if uv.name != first.name]
+
+
+def corner_uv(layer, n_loops):
+    """One UV map per corner, float32 (n_loops, 2)."""
     out = np.empty(n_loops * 2, dtype=np.float32)
     if hasattr(layer, "uv") and len(layer.uv) == n_loops:  # 3.5+
         layer.uv.foreach_get("vector", out)
     else:
         layer.data.foreach_get("uv", out)
     return out.reshape(-1, 2)
+
+
+def corner_uvs(mesh, n_loops):
+    """Active render UV map per corner, float32 (n_loops, 2), or None."""
+    layers = uv_layers(mesh)
+    return corner_uv(layers[0], n_loops) if layers else None
+
+
+def color_layers(mesh):
+    """Colour attributes (3.2+ color_attributes; legacy vertex_colors before), the render one
+    first: a list of (name, domain, collection of elements with a linear 'color')."""
+    attrs = getattr(mesh, "color_attributes", None)
+    if attrs is not None:
+        items = [a for a in attrs if a.domain in ("CORNER", "POINT")]
+        first = getattr(attrs, "default_color_name", None)
+        if first is None:
+            render = getattr(attrs, "render_color_index", -1)
+            all_attrs = list(attrs)
+            first = all_attrs[render].name if 0 <= render < len(all_attrs) else None
+        items.sort(key=lambda a: a.name != first)  # stable: the render one first
+        return [(a.name, a.domain, a.data) for a in items]
+    vcols = getattr(mesh, "vertex_colors", None)
+    if vcols is None:
+        return []
+    items = list(vcols)
+    items.sort(key=lambda a: not getattr(a, "active_render", False))
+    return [(a.name, "CORNER", a.data) for a in items]
+
+
+def corner_tangents(mesh, uv_name, n_loops):
+    """Blender's MikkTSpace tangents for a UV map: (float32 (n, 3), float32 (n,) bitangent sign).
+    Raises RuntimeError where Blender cannot compute them (n-gons)."""
+    mesh.calc_tangents(uvmap=uv_name)
+    try:
+        t = np.empty(n_loops * 3, dtype=np.float32)
+        mesh.loops.foreach_get("tangent", t)
+        sign = np.empty(n_loops, dtype=np.float32)
+        mesh.loops.foreach_get("bitangent_sign", sign)
+    finally:
+        if hasattr(mesh, "free_tangents"):
+            mesh.free_tangents()
+    return t.reshape(-1, 3), sign
+
+
+def texture_space(mesh):
+    """(location, size) of the mesh's texture space (Generated coordinates), or None."""
+    loc = getattr(mesh, "texspace_location", None)
+    size = getattr(mesh, "texspace_size", None)
+    if loc is None or size is None:
+        return None
+    return [float(v) for v in loc], [float(v) for v in size]
 
 
 # --- render result -----------------------------------------------------------
@@ -166,3 +265,284 @@ def visible_camera(obj):
 
 def is_extension_platform():
     return VERSION >= (4, 2, 0)
+
+
+# --- shader node vocabulary -------------------------------------------------------
+#
+# translate_node() rewrites one exported node (Blender's identifiers of the running version) into
+# the 5.x vocabulary the material graph uses. `entry` is the node's graph dict ({"type", "props",
+# "inputs", "internal_links", ...}; inputs hold values or {"link": [node, output]}); `emit(dict)`
+# appends a helper node and returns its index. The return value maps an output identifier of the
+# Blender node to the [node index, output identifier] that now carries it (only outputs that
+# moved). Conversions follow Blender's versioning code (versioning_400.cc, versioning_410.cc).
+
+_ONE = [1.0, 1.0, 1.0, 1.0]
+
+
+def _is_link(v):
+    return isinstance(v, dict) and "link" in v
+
+
+def _lerp(a, b, t):
+    return [float(x) + (float(y) - float(x)) * float(t) for x, y in zip(a, b)]
+
+
+def _rename(entry, inputs=None, outputs=None):
+    """Rename input identifiers (and internal links) of a node entry in place."""
+    inputs = inputs or {}
+    outputs = outputs or {}
+    old = entry["inputs"]
+    entry["inputs"] = {inputs.get(k, k): v for k, v in old.items()}
+    entry["internal_links"] = {outputs.get(o, o): inputs.get(i, i)
+                               for o, i in entry.get("internal_links", {}).items()}
+
+
+def _helper(entry, what, type_, props, inputs):
+    h = {"name": "%s [%s]" % (entry["name"], what), "type": type_, "props": props,
+         "inputs": inputs, "internal_links": {}}
+    if "group" in entry:
+        h["group"] = entry["group"]
+    return h
+
+
+def _math(emit, entry, what, op, a, b, clamp=False):
+    idx = emit(_helper(entry, what, "ShaderNodeMath", {"operation": op, "use_clamp": clamp},
+                       {"Value": a, "Value_001": b}))
+    return {"link": [idx, "Value"]}
+
+
+def _clamp01(emit, entry, what, value):
+    idx = emit(_helper(entry, what, "ShaderNodeClamp", {"clamp_type": "MINMAX"},
+                       {"Value": value, "Min": 0.0, "Max": 1.0}))
+    return {"link": [idx, "Result"]}
+
+
+def _mix_color(emit, entry, what, fac, a, b):
+    idx = emit(_helper(entry, what, "ShaderNodeMix",
+                       {"data_type": "RGBA", "blend_type": "MIX", "factor_mode": "UNIFORM",
+                        "clamp_factor": True, "clamp_result": False},
+                       {"Factor_Float": fac, "A_Color": a, "B_Color": b}))
+    return {"link": [idx, "Result_Color"]}
+
+
+def _translate_mixrgb(node, entry, index, emit):
+    # The legacy node always clamps its factor (Cycles' svm_node_mix); use_alpha is ignored by
+    # Cycles; use_clamp clamps the result.
+    props = entry["props"]
+    entry["type"] = "ShaderNodeMix"
+    entry["props"] = {"data_type": "RGBA", "factor_mode": "UNIFORM",
+                      "blend_type": props.get("blend_type", "MIX"), "clamp_factor": True,
+                      "clamp_result": bool(props.get("use_clamp", False))}
+    _rename(entry, {"Fac": "Factor_Float", "Color1": "A_Color", "Color2": "B_Color"},
+            {"Color": "Result_Color"})
+    return {"Color": [index, "Result_Color"]}
+
+
+_LEGACY_COLOR_NODES = {
+    # bl_idname: (new type, mode, input renames, output renames)
+    "ShaderNodeSeparateRGB": ("ShaderNodeSeparateColor", "RGB", {"Image": "Color"},
+                              {"R": "Red", "G": "Green", "B": "Blue"}),
+    "ShaderNodeCombineRGB": ("ShaderNodeCombineColor", "RGB", {"R": "Red", "G": "Green", "B": "Blue"},
+                             {"Image": "Color"}),
+    "ShaderNodeSeparateHSV": ("ShaderNodeSeparateColor", "HSV", {},
+                              {"H": "Red", "S": "Green", "V": "Blue"}),
+    "ShaderNodeCombineHSV": ("ShaderNodeCombineColor", "HSV", {"H": "Red", "S": "Green", "V": "Blue"},
+                             {}),
+}
+
+
+def _translate_legacy_color(node, entry, index, emit):
+    new_type, mode, ins, outs = _LEGACY_COLOR_NODES[entry["type"]]
+    entry["type"] = new_type
+    entry["props"] = {"mode": mode}
+    _rename(entry, ins, outs)
+    return {old: [index, new] for old, new in outs.items()}
+
+
+def _translate_principled_v1(node, entry, index, emit):
+    """Principled BSDF of Blender 3.x -> 4.0's, as versioning_400.cc converts it."""
+    inp = entry["inputs"]
+    # Transmission Roughness is gone (4.0 uses Roughness for refraction too).
+    inp.pop("Transmission Roughness", None)
+    # Sheen (version_principled_bsdf_sheen): the tint becomes a colour; a fixed sheen is scaled.
+    # A linked tint keeps its link (a float into a colour input, as Blender leaves it).
+    sheen = inp.get("Sheen", 0.0)
+    tint_linked = _is_link(inp.get("Sheen Tint"))
+    if not _is_link(sheen):
+        inp["Sheen"] = float(sheen) * 0.2
+        if not tint_linked:
+            inp["Sheen Tint"] = list(_ONE)
+    elif not tint_linked:
+        inp["Sheen Tint"] = [0.2, 0.2, 0.2, 1.0]
+    # Coat (version_principled_bsdf_coat).
+    coat = inp.get("Clearcoat", 0.0)
+    if _is_link(coat):
+        inp["Coat IOR"] = 1.2
+    else:
+        inp["Clearcoat"] = float(coat) * 0.25
+        inp["Coat IOR"] = 1.5
+    # Subsurface (version_principled_bsdf_subsurface).
+    ss = inp.get("Subsurface", 0.0)
+    ss_color = inp.pop("Subsurface Color", [0.8, 0.8, 0.8, 1.0])
+    if not _is_link(ss) and float(ss) == 0.0:
+        inp["Subsurface Scale"] = 0.05
+    else:
+        inp["Subsurface Scale"] = ss
+        base = inp.get("Base Color", [0.8, 0.8, 0.8, 1.0])
+        if _is_link(ss) or _is_link(ss_color) or _is_link(base):
+            inp["Base Color"] = _mix_color(emit, entry, "subsurface colour", ss, base, ss_color)
+        else:
+            inp["Base Color"] = _lerp(base, ss_color, ss)
+        inp["Subsurface"] = 1.0
+    # Specular tint (version_principled_bsdf_specular_tint): a colour,
+    # mix(one, mix(base_color, one, metallic), old_tint).
+    tint = inp.get("Specular Tint", 0.0)
+    base = inp.get("Base Color", [0.8, 0.8, 0.8, 1.0])
+    metallic = inp.get("Metallic", 0.0)
+    if not _is_link(tint) and float(tint) <= 0.0:
+        inp["Specular Tint"] = list(_ONE)
+    else:
+        if _is_link(metallic) or (_is_link(base) and float(metallic) > 0.0):
+            metallic_mix = _mix_color(emit, entry, "specular tint metallic", metallic, base, list(_ONE))
+        elif _is_link(base):
+            metallic_mix = base
+        else:
+            metallic_mix = _lerp(base, _ONE, metallic)
+        if _is_link(tint) or _is_link(metallic_mix):
+            inp["Specular Tint"] = _mix_color(emit, entry, "specular tint", tint, list(_ONE), metallic_mix)
+        else:
+            inp["Specular Tint"] = _lerp(_ONE, metallic_mix, tint)
+    _rename(entry, {"Emission": "Emission Color", "Specular": "Specular IOR Level",
+                    "Subsurface": "Subsurface Weight", "Transmission": "Transmission Weight",
+                    "Clearcoat": "Coat Weight", "Clearcoat Roughness": "Coat Roughness",
+                    "Clearcoat Normal": "Coat Normal", "Sheen": "Sheen Weight"})
+    return None
+
+
+# 4.0 renamed the subsurface methods: the old fixed-radius walk is now "Random Walk" and the old
+# "Random Walk" (with IOR) is "Random Walk (Skin)".
+_SUBSURFACE_METHOD_3X = {"RANDOM_WALK_FIXED_RADIUS": "RANDOM_WALK", "RANDOM_WALK": "RANDOM_WALK_SKIN"}
+
+
+def _remove_sharp(entry):
+    """4.0 removed the Sharp distribution: GGX with roughness 0 (link removed)."""
+    if entry["props"].get("distribution") == "SHARP":
+        entry["props"]["distribution"] = "GGX"
+        entry["inputs"]["Roughness"] = 0.0
+
+
+def _translate_noise_3x(node, entry, index, emit):
+    """Noise before 4.1 (no type): fBM with its roughness clamped (versioning_410); before 4.0
+    (no normalize flag either) always normalized (400.16 sets the flag)."""
+    entry["props"]["noise_type"] = "FBM"
+    entry["props"].setdefault("normalize", True)
+    rough = entry["inputs"].get("Roughness")
+    if _is_link(rough):
+        entry["inputs"]["Roughness"] = _clamp01(emit, entry, "roughness clamp", rough)
+    elif rough is not None:
+        entry["inputs"]["Roughness"] = min(1.0, max(0.0, float(rough)))
+    return None
+
+
+def _translate_musgrave(node, entry, index, emit):
+    """Musgrave (removed in 4.1) -> Noise, as versioning_replace_musgrave_texture_node does."""
+    props, inp = entry["props"], entry["inputs"]
+    kind = props.get("musgrave_type", "FBM")
+    entry["type"] = "ShaderNodeTexNoise"
+    entry["props"] = {"noise_dimensions": props.get("musgrave_dimensions", "3D"),
+                      "noise_type": kind, "normalize": False}
+    _rename(entry, {"Dimension": "Roughness"})
+    inp = entry["inputs"]
+    outputs = {}
+    fac = {"link": [index, "Fac"]}
+    detail = inp.get("Detail", 2.0)
+    ridged_or_hetero = kind in ("RIDGED_MULTIFRACTAL", "HETERO_TERRAIN")
+    if _is_link(detail):
+        sub1_b = 1.0
+        if ridged_or_hetero:
+            sub1_b = _math(emit, entry, "detail > 1", "GREATER_THAN", detail, 1.0)
+        sub1 = _math(emit, entry, "detail - 1", "SUBTRACT", detail, sub1_b)
+        inp["Detail"] = _math(emit, entry, "detail min", "MINIMUM", sub1, 14.0)
+        if not ridged_or_hetero:
+            clamp = _clamp01(emit, entry, "detail clamp", detail)
+            mul = _math(emit, entry, "fac * detail", "MULTIPLY", fac, clamp)
+            if kind == "MULTIFRACTAL":
+                sub2 = _math(emit, entry, "1 - detail", "SUBTRACT", 1.0, detail, clamp=True)
+                outputs["Fac"] = _math(emit, entry, "fac offset", "ADD", mul, sub2)["link"]
+            else:
+                outputs["Fac"] = mul["link"]
+    else:
+        detail = float(detail)
+        if detail < 1.0:
+            if not ridged_or_hetero:
+                mul = _math(emit, entry, "fac * detail", "MULTIPLY", fac, detail)
+                if kind == "MULTIFRACTAL":
+                    outputs["Fac"] = _math(emit, entry, "fac offset", "ADD", mul, 1.0 - detail)["link"]
+                else:
+                    outputs["Fac"] = mul["link"]
+                inp["Detail"] = 0.0
+        else:
+            inp["Detail"] = min(detail - 1.0, 14.0)
+    rough = inp.get("Roughness", 2.0)
+    lac = inp.get("Lacunarity", 2.0)
+    if not _is_link(rough):
+        rough = max(float(rough), 1e-5)
+    if not _is_link(lac):
+        lac = max(float(lac), 1e-5)
+    if _is_link(rough):
+        max1 = _math(emit, entry, "roughness max", "MAXIMUM", rough, -1e-5)
+        neg = _math(emit, entry, "-roughness", "MULTIPLY", max1, -1.0)
+        if _is_link(lac):
+            lac = _math(emit, entry, "lacunarity max", "MAXIMUM", lac, -1e-5)
+        inp["Roughness"] = _math(emit, entry, "lacunarity ^ -roughness", "POWER", lac, neg)
+        inp["Lacunarity"] = lac
+    elif _is_link(lac):
+        lac = _math(emit, entry, "lacunarity max", "MAXIMUM", lac, -1e-5)
+        inp["Roughness"] = _math(emit, entry, "lacunarity ^ -roughness", "POWER", lac, -rough)
+        inp["Lacunarity"] = lac
+    else:
+        inp["Roughness"] = lac ** (-rough)
+        inp["Lacunarity"] = lac
+    return {k: list(v) for k, v in outputs.items()}
+
+
+def translate_node(node, entry, index, emit):
+    """Rewrite `entry` into the 5.x vocabulary (see the comment above). Returns the moved outputs."""
+    t = entry["type"]
+    if t == "ShaderNodeMixRGB":
+        return _translate_mixrgb(node, entry, index, emit)
+    if t in _LEGACY_COLOR_NODES:
+        return _translate_legacy_color(node, entry, index, emit)
+    if t == "ShaderNodeTexMusgrave":
+        return _translate_musgrave(node, entry, index, emit)
+    if t == "ShaderNodeTexNoise" and "noise_type" not in entry["props"]:
+        return _translate_noise_3x(node, entry, index, emit)
+    if t == "ShaderNodeBsdfPrincipled":
+        method = entry["props"].get("subsurface_method")
+        if VERSION < (4, 0, 0) and method in _SUBSURFACE_METHOD_3X:
+            entry["props"]["subsurface_method"] = _SUBSURFACE_METHOD_3X[method]
+        if node.inputs.get("Subsurface Color") is not None or node.inputs.get("Clearcoat") is not None:
+            return _translate_principled_v1(node, entry, index, emit)
+        return None
+    if t == "ShaderNodeSubsurfaceScattering":
+        falloff = entry["props"].get("falloff")
+        if VERSION < (4, 0, 0) and falloff in _SUBSURFACE_METHOD_3X:
+            entry["props"]["falloff"] = _SUBSURFACE_METHOD_3X[falloff]
+        return None
+    if t == "ShaderNodeBsdfGlossy":
+        # 4.0 merged Anisotropic into Glossy under the Anisotropic node's bl_idname.
+        entry["type"] = "ShaderNodeBsdfAnisotropic"
+        _remove_sharp(entry)
+        return None
+    if t in ("ShaderNodeBsdfAnisotropic", "ShaderNodeBsdfGlass", "ShaderNodeBsdfRefraction"):
+        _remove_sharp(entry)
+        return None
+    if t == "ShaderNodeBsdfVelvet":
+        entry["type"] = "ShaderNodeBsdfSheen"
+        entry["props"] = {"distribution": "ASHIKHMIN"}
+        _rename(entry, {"Sigma": "Roughness"})
+        return None
+    if t == "ShaderNodeBsdfHairPrincipled" and "model" not in entry["props"]:
+        entry["props"]["model"] = "CHIANG"
+        return None
+    return None

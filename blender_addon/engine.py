@@ -14,7 +14,7 @@ import time
 import bpy
 import numpy as np
 
-from . import compat, export, preferences, protocol
+from . import compat, export, preferences, protocol, report
 
 POLL_SECONDS = 0.03        # how often render() looks at the queue and test_break()
 PUSH_SECONDS = 0.25        # how often the render result is refreshed
@@ -153,6 +153,7 @@ class RenderSession:
         self.reader = None
         self.stderr = None
         self.messages = queue.Queue()
+        self.fallbacks = None  # report.FallbackReport once the scene is exported
 
     def start(self, args):
         self.proc = subprocess.Popen(args, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
@@ -242,6 +243,17 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
             self._fail("internal error in the add-on: %s: %s" % (type(exc).__name__, exc))
         finally:
             session.close()
+            self._publish_fallbacks(scene, session)
+
+    @staticmethod
+    def _publish_fallbacks(scene, session):
+        """This render's per-material fallbacks (add-on and renderer) replace the last ones."""
+        fallbacks = session.fallbacks
+        if fallbacks is None:
+            return
+        if session.stderr is not None:
+            fallbacks.add_renderer_text(session.stderr.text(max_lines=1 << 20))
+        report.publish(scene.name, fallbacks)
 
     def _render(self, depsgraph, scene, settings, width, height, region, rw, rh, session):
         self.update_stats("", "Tesela | Exporting scene")
@@ -261,8 +273,15 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
                                     render_settings=render_settings, check_cancel=self.should_stop)
         except export.ExportCancelled:
             return
+        session.fallbacks = report.FallbackReport()
+        session.fallbacks.add_addon_all(res.material_warnings)
         for w in res.warnings[:20]:
             print("Tesela: " + w)
+        if len(res.warnings) > 20:
+            print("Tesela: ... and %d more warnings" % (len(res.warnings) - 20))
+        if res.material_warnings:
+            self.report({"WARNING"}, "Tesela: %d material(s) could not be translated fully (see "
+                        "Material Properties > Tesela)" % len(res.material_warnings))
         if self.should_stop():
             return
         t_export = time.monotonic() - t0
@@ -378,6 +397,7 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
                         msg.spp, msg.tile_count, time.monotonic() - t_start))
                 elif isinstance(msg, protocol.Log):
                     print("Tesela renderer: " + msg.message)
+                    session.fallbacks.add_renderer_line(msg.message)
                     if msg.level >= 2:
                         self.report({"WARNING"}, "Tesela: " + msg.message)
                 elif isinstance(msg, protocol.Error):

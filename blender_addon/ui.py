@@ -1,11 +1,12 @@
 # SPDX-License-Identifier: MIT
-"""Render panel, reuse of Blender's own panels, and the File > Export entry."""
+"""Render panel, the Material tab's fallback list, reuse of Blender's own panels, and the
+File > Export entry."""
 
 import bpy
 from bpy.props import BoolProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper
 
-from . import export, preferences
+from . import export, preferences, report
 
 ENGINE = "TESELA"
 
@@ -60,6 +61,41 @@ class TESELA_PT_render(bpy.types.Panel):
             box.label(text="Set it in Preferences > Add-ons > Tesela")
 
 
+class TESELA_PT_material_fallbacks(bpy.types.Panel):
+    """What Tesela could not translate or render for the active material in the last render."""
+    bl_label = "Tesela"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "material"
+    bl_options = {"DEFAULT_CLOSED"}
+    COMPAT_ENGINES = {ENGINE}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES and getattr(context, "material", None) is not None
+
+    def draw(self, context):
+        layout = self.layout
+        mat = context.material
+        last = report.get(context.scene.name)
+        if last is None:
+            layout.label(text="Not rendered with Tesela since the file was opened", icon="INFO")
+            return
+        addon, renderer = last.for_material(mat.name)
+        if not addon and not renderer:
+            layout.label(text="Nothing fell back in the last render", icon="CHECKMARK")
+            return
+        prefix = "material '%s': " % mat.name
+        for title, lines in (("Add-on", addon), ("Renderer", renderer)):
+            if not lines:
+                continue
+            box = layout.box()
+            box.label(text=title, icon="ERROR")
+            col = box.column(align=True)
+            for line in lines:
+                col.label(text=line[len(prefix):] if line.startswith(prefix) else line)
+
+
 class TESELA_OT_export_gltf(bpy.types.Operator, ExportHelper):
     """Export the evaluated scene as Tesela glTF (.gltf + .bin) for the command line renderer"""
     bl_idname = "export_scene.tesela_gltf"
@@ -85,6 +121,9 @@ class TESELA_OT_export_gltf(bpy.types.Operator, ExportHelper):
         camera = scene.camera.evaluated_get(depsgraph) if scene.camera is not None else None
         res = export.write_gltf(depsgraph, self.filepath, width=width, height=height,
                                 camera=camera, render_settings=settings, selection=selection)
+        fallbacks = report.FallbackReport()
+        fallbacks.add_addon_all(res.material_warnings)
+        report.publish(scene.name, fallbacks)
         for w in res.warnings[:20]:
             self.report({"WARNING"}, w)
         self.report({"INFO"}, "Tesela: wrote %s (%d triangles)" % (self.filepath, res.triangles))
@@ -98,9 +137,17 @@ def _menu_export(self, context):
 _added = []  # panels we added the engine to (registration state, not render state)
 
 
+@bpy.app.handlers.persistent
+def _on_load(*_args):
+    report.clear()  # another file: the last render's fallbacks belong to the old one
+
+
 def register():
     bpy.utils.register_class(TESELA_PT_render)
+    bpy.utils.register_class(TESELA_PT_material_fallbacks)
     bpy.utils.register_class(TESELA_OT_export_gltf)
+    if _on_load not in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.append(_on_load)
     bpy.types.TOPBAR_MT_file_export.append(_menu_export)
     for cls in _compat_panels():
         if ENGINE not in cls.COMPAT_ENGINES:
@@ -113,5 +160,8 @@ def unregister():
         cls = _added.pop()
         cls.COMPAT_ENGINES.discard(ENGINE)
     bpy.types.TOPBAR_MT_file_export.remove(_menu_export)
+    if _on_load in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.remove(_on_load)
     bpy.utils.unregister_class(TESELA_OT_export_gltf)
+    bpy.utils.unregister_class(TESELA_PT_material_fallbacks)
     bpy.utils.unregister_class(TESELA_PT_render)

@@ -208,7 +208,7 @@ fn parse_input(v: &Value, n: usize) -> Result<Input, String> {
 
 fn finite(x: Option<f64>) -> Result<f32, String> {
     match x {
-        Some(x) if x.is_finite() && x.abs() < 3.0e38 => Ok(x as f32),
+        Some(x) if x.is_finite() && x.abs() <= f32::MAX as f64 => Ok(x as f32),
         Some(x) => Err(format!("the constant {x} is not a finite number")),
         None => Err("a constant component is not a number".into()),
     }

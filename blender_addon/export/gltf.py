@@ -1,0 +1,263 @@
+# SPDX-License-Identifier: MIT
+"""The glTF document of one export: walks the depsgraph's object instances, asks the per-kind
+modules (mesh, material, light, camera, world) for their parts and writes .gltf + .bin."""
+
+import json
+import os
+
+import numpy as np
+
+from .. import compat
+from .buffer import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT, UINT, Buffer
+from .camera import camera_fields, camera_matrix
+from .common import ExportCancelled, gltf_matrix, matrix
+from .images import ImageTable, Textures
+from .light import convert_light
+from .material import DEFAULT_MATERIAL, MaterialReport, export_material
+from .mesh import MESHLIKE, mesh_arrays, object_extras
+from .world import convert_world
+
+
+class ExportResult:
+    def __init__(self):
+        self.warnings = []
+        self.material_warnings = {}  # material name -> [messages] (what fell back)
+        self.triangles = 0
+        self.has_camera = False
+        self.gltf_path = None
+        self.bin_path = None
+
+
+def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settings=None,
+               check_cancel=None, selection=None):
+    """Write the evaluated scene of `depsgraph` to `filepath` (.gltf) + a .bin beside it.
+
+    width/height: the final render resolution (percentage applied).
+    camera: evaluated camera object (defaults to the scene's).
+    render_settings: dict for the TESELA_render extension, or None.
+    check_cancel: callable returning True to abort (raises ExportCancelled).
+    selection: optional set of original object names to restrict the export.
+    """
+    res = ExportResult()
+    warnings = res.warnings
+    scene = depsgraph.scene
+    buf = Buffer()
+    doc = {"asset": {"version": "2.0", "generator": "Tesela Blender add-on"},
+           "scene": 0, "scenes": [{"name": scene.name, "nodes": []}],
+           "nodes": [], "meshes": [], "materials": [], "cameras": []}
+    used_ext = set()
+    root_nodes = doc["scenes"][0]["nodes"]
+    material_index = {}   # material key -> (glTF index, tangent UV maps)
+    out_dir = os.path.dirname(os.path.abspath(filepath))
+    stem = os.path.splitext(os.path.basename(filepath))[0]
+    textures = Textures(out_dir, stem, warnings)
+    report = MaterialReport(warnings, res.material_warnings)
+    images = ImageTable(buf, report)
+    mesh_cache = {}
+    khr_lights = []
+
+    def mat_idx(mat):
+        key = getattr(mat, "name_full", mat.name) if mat is not None else None
+        if key in material_index:
+            return material_index[key]
+        tangent_uvs = set()
+        if mat is None:
+            m = dict(DEFAULT_MATERIAL)
+        else:
+            exported = export_material(mat, warnings, textures, images, report)
+            m, tangent_uvs = exported.gltf, exported.tangent_uvs
+        for e in m.get("extensions", {}):
+            used_ext.add(e)
+        doc["materials"].append(m)
+        material_index[key] = (len(doc["materials"]) - 1, tangent_uvs)
+        return material_index[key]
+
+    def add_node(node):
+        doc["nodes"].append(node)
+        root_nodes.append(len(doc["nodes"]) - 1)
+
+    def add_mesh(obj, mesh):
+        mats = [s.material for s in obj.material_slots] or [None]
+        infos = [mat_idx(m) for m in mats]
+        mat_ids = [i for i, _ in infos]
+        tangent_uvs = set().union(*(t for _, t in infos))
+        data = mesh_arrays(mesh, check_cancel, tangent_uvs, warnings.append, obj.name)
+        if data is None:
+            return None
+        attrs = {"POSITION": buf.add(data.positions, FLOAT, "VEC3", ARRAY_BUFFER, True),
+                 "NORMAL": buf.add(data.normals, FLOAT, "VEC3", ARRAY_BUFFER)}
+        for i, (_, uv) in enumerate(data.uv_sets):
+            attrs["TEXCOORD_%d" % i] = buf.add(uv, FLOAT, "VEC2", ARRAY_BUFFER)
+        if not data.uv_sets and any("baseColorTexture" in doc["materials"][i]["pbrMetallicRoughness"]
+                                    for i in mat_ids):
+            # No UV map: Cycles reads UV (0, 0) everywhere; so does the fallback texture.
+            uv = np.zeros((data.positions.shape[0], 2), dtype=np.float32)
+            uv[:, 1] = 1.0
+            attrs["TEXCOORD_0"] = buf.add(uv, FLOAT, "VEC2", ARRAY_BUFFER)
+        for i, (_, col) in enumerate(data.color_sets):
+            attrs["COLOR_%d" % i] = buf.add(col, FLOAT, "VEC4", ARRAY_BUFFER)
+        if data.tangents is not None:
+            attrs["TANGENT"] = buf.add(data.tangents, FLOAT, "VEC4", ARRAY_BUFFER)
+        extras = {"tesela_uv_names": [n for n, _ in data.uv_sets],
+                  "tesela_color_names": [n for n, _ in data.color_sets]}
+        if data.tangent_uv is not None:
+            extras["tesela_tangent_uv"] = data.tangent_uv
+        tri_mat = np.clip(data.tri_material, 0, len(mats) - 1)
+        indices = data.indices
+        prims = []
+        single = tri_mat.min() == tri_mat.max()
+        for mi in ([tri_mat[0]] if single else np.unique(tri_mat)):
+            sel = indices if single else indices[tri_mat == mi]
+            acc = buf.add(sel.reshape(-1), UINT, "SCALAR", ELEMENT_ARRAY_BUFFER, True)
+            prims.append({"attributes": attrs, "indices": acc, "mode": 4,
+                          "material": mat_ids[int(mi)], "extras": extras})
+        doc["meshes"].append({"name": obj.name, "primitives": prims})
+        return (len(doc["meshes"]) - 1, int(indices.shape[0]), data.texspace)
+
+    count = 0
+    for inst in depsgraph.object_instances:
+        count += 1
+        if check_cancel is not None and count % 64 == 0 and check_cancel():
+            raise ExportCancelled()
+        obj = inst.object
+        if selection is not None:
+            orig = inst.instance_object if inst.is_instance else obj
+            orig = getattr(orig, "original", orig)
+            if inst.is_instance:
+                par = getattr(inst.parent, "original", inst.parent)
+                if par is None or par.name not in selection:
+                    continue
+            elif orig.name not in selection:
+                continue
+        otype = obj.type
+        if otype in MESHLIKE:
+            data = obj.data
+            key = (obj.name, data.as_pointer() if data is not None else 0)
+            if key not in mesh_cache:
+                if check_cancel is not None and check_cancel():
+                    raise ExportCancelled()
+                mesh_cache[key] = None
+                mesh = None
+                try:
+                    mesh = obj.to_mesh()
+                except RuntimeError:
+                    mesh = None
+                if mesh is not None:
+                    try:
+                        mesh_cache[key] = add_mesh(obj, mesh)
+                    finally:
+                        obj.to_mesh_clear()
+            cached = mesh_cache[key]
+            if cached is None:
+                continue
+            if not compat.visible_camera(obj):
+                warnings.append("object '%s' is hidden from the camera; Tesela renders it anyway" % obj.name)
+            mi, ntri, texspace = cached
+            res.triangles += ntri
+            extras = {"tesela_object": object_extras(inst, obj)}
+            if texspace is not None:
+                extras["tesela_texspace"] = {"location": texspace[0], "size": texspace[1]}
+            add_node({"name": obj.name, "mesh": mi, "matrix": gltf_matrix(matrix(inst.matrix_world)),
+                      "extras": extras})
+        elif otype in ("CURVES", "POINTCLOUD", "VOLUME", "GPENCIL", "GREASEPENCIL"):
+            if ("skip", otype) not in mesh_cache:
+                mesh_cache[("skip", otype)] = None
+                warnings.append("%s objects are not supported; '%s' (and any others) left out"
+                                % (otype.lower(), obj.name))
+        elif otype == "LIGHT":
+            ext, khr = convert_light(obj.data, obj, matrix(inst.matrix_world), warnings)
+            node = {"name": obj.name, "matrix": gltf_matrix(matrix(inst.matrix_world)),
+                    "extensions": {"TESELA_light": ext}}
+            used_ext.add("TESELA_light")
+            if khr is not None:
+                khr["name"] = obj.data.name
+                khr_lights.append(khr)
+                node["extensions"]["KHR_lights_punctual"] = {"light": len(khr_lights) - 1}
+                used_ext.add("KHR_lights_punctual")
+            add_node(node)
+
+    cam = camera if camera is not None else scene.camera
+    if cam is not None and cam.type == "CAMERA":
+        cd = cam.data
+        if cd.type == "PANO":
+            warnings.append("camera '%s': panoramic cameras are not supported; rendering it as "
+                            "a perspective camera" % cam.name)
+        if abs(cd.shift_x) > 1e-6 or abs(cd.shift_y) > 1e-6:
+            warnings.append("camera '%s': lens shift is ignored" % cam.name)
+        if getattr(getattr(cd, "dof", None), "use_dof", False):
+            warnings.append("camera '%s': depth of field is ignored" % cam.name)
+        doc["cameras"].append(dict(camera_fields(cam.data, width, height), name=cam.data.name))
+        add_node({"name": cam.name, "camera": 0, "matrix": gltf_matrix(camera_matrix(cam))})
+        res.has_camera = True
+
+    world = convert_world(scene.world, warnings)
+    ext_root = {"TESELA_world": world}
+    used_ext.add("TESELA_world")
+    if render_settings is not None:
+        ext_root["TESELA_render"] = render_settings
+        used_ext.add("TESELA_render")
+    if khr_lights:
+        ext_root["KHR_lights_punctual"] = {"lights": khr_lights}
+    if images.images:
+        ext_root["TESELA_images"] = {"images": images.images}
+        used_ext.add("TESELA_images")
+    doc["extensions"] = ext_root
+
+    if textures.images:
+        doc["images"] = textures.images
+        doc["samplers"] = textures.samplers
+        doc["textures"] = textures.textures
+    # Remove empty top-level arrays (glTF forbids empty arrays).
+    for k in ("nodes", "meshes", "materials", "cameras"):
+        if not doc[k]:
+            del doc[k]
+    if not root_nodes:
+        del doc["scenes"][0]["nodes"]
+
+    base = os.path.splitext(os.path.basename(filepath))[0]
+    bin_name = base + ".bin"
+    bin_path = os.path.join(os.path.dirname(os.path.abspath(filepath)), bin_name)
+    if buf.length:
+        from urllib.parse import quote
+        doc["buffers"] = [{"uri": quote(bin_name), "byteLength": buf.length}]
+        doc["bufferViews"] = buf.views
+        doc["accessors"] = buf.accessors
+        with open(bin_path, "wb") as f:
+            for chunk in buf.chunks:
+                f.write(chunk)
+        res.bin_path = bin_path
+    doc["extensionsUsed"] = sorted(used_ext)
+    with open(filepath, "w", encoding="utf-8") as f:
+        json.dump(doc, f, ensure_ascii=False, separators=(",", ":"))
+    res.gltf_path = filepath
+    return res
+
+
+def render_size(render):
+    """Final render resolution (percentage applied), as Blender computes it."""
+    pct = render.resolution_percentage
+    return (max(1, int(render.resolution_x * pct / 100)),
+            max(1, int(render.resolution_y * pct / 100)))
+
+
+def border_region(render, width, height):
+    """The border as (x, y, w, h), top-left origin, or None for the full frame.
+
+    Blender's render result for a border is trunc((max - min) * size) pixels wide (measured
+    with Blender 3.4 and 5.0), placed at trunc(min * size).
+    """
+    if not render.use_border:
+        return None
+    bx0, bx1 = sorted((render.border_min_x, render.border_max_x))
+    by0, by1 = sorted((render.border_min_y, render.border_max_y))
+    bx0, by0 = max(0.0, bx0), max(0.0, by0)
+    bx1, by1 = min(1.0, bx1), min(1.0, by1)
+    xmin = int(bx0 * width)
+    ymin = int(by0 * height)
+    w = int((bx1 - bx0) * width)
+    h = int((by1 - by0) * height)
+    w = max(1, min(w, width - xmin))
+    h = max(1, min(h, height - ymin))
+    if (xmin, ymin, w, h) == (0, 0, width, height):
+        return None
+    return (xmin, height - ymin - h, w, h)
