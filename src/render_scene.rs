@@ -533,25 +533,31 @@ impl RenderScene {
     /// (reused for the closure's own lobe choice): `(closure, 1 / choice probability)`, or
     /// `None` when the material has no BSDF there.
     #[inline]
-    pub fn choose_closure(
-        &self,
-        ctx: &mut Ctx,
+    pub fn choose_closure<'a>(
+        &'a self,
+        ctx: &'a mut Ctx,
         its: &Intersection,
         d: Vec3,
         depth: u32,
         u: f32,
-    ) -> Option<(crate::shading::Closure, f32, f32)> {
+    ) -> Option<(&'a crate::shading::Closure, f32, f32)> {
         let program = &self.programs[its.material as usize];
-        let flags = if depth <= 1 {
-            crate::shading::globals::ray::CAMERA
-        } else {
-            ctx.ray_flags
+        // Constant materials (most of them) need no shading point at all.
+        let set = match program.constant_set() {
+            Some(set) => set,
+            None => {
+                let flags = if depth <= 1 {
+                    crate::shading::globals::ray::CAMERA
+                } else {
+                    ctx.ray_flags
+                };
+                let g = self.globals(its, d, depth, flags);
+                let env = self.shade_env();
+                program.eval(&g, &env, &mut ctx.shade)
+            }
         };
-        let g = self.globals(its, d, depth, flags);
-        let env = self.shade_env();
-        let set = program.eval(&g, &env, &mut ctx.shade);
         let (i, p, u) = set.choose(u)?;
-        Some((set.closures[i], 1.0 / p, u))
+        Some((&set.closures[i], 1.0 / p, u))
     }
 
     /// Surface albedo at a hit (the debug view): the chosen closure's colour.

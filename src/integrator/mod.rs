@@ -77,7 +77,7 @@ impl ShadingPoint {
     ) -> Option<Self> {
         let u = ctx.sampler.next_1d();
         let (closure, inv_p, u) = scene.choose_closure(ctx, its, d, depth, u)?;
-        let bsdf = bsdf::from_closure(&closure, u);
+        let bsdf = bsdf::from_closure(closure, u);
         // The closure's normal faces the viewer (Cycles' N); zero means the shading normal.
         let mut n = if closure.normal == Vec3::ZERO {
             its.ns

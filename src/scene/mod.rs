@@ -96,15 +96,16 @@ impl Default for MeshAttributes {
 
 impl Mesh {
     /// The three vertex indices of triangle `tri`.
-    #[inline]
+    #[inline(always)]
     pub fn corners(&self, tri: u32) -> [usize; 3] {
-        self.indices[tri as usize].map(|i| i as usize)
+        let [a, b, c] = self.indices[tri as usize];
+        [a as usize, b as usize, c as usize]
     }
 
     /// Barycentric interpolation `a·b0 + b·b1 + c·b2` of a per-vertex attribute at triangle
     /// `tri` with barycentrics `(b1, b2)`; `None` when the attribute is empty. The one place
     /// where vertex attributes are interpolated.
-    #[inline]
+    #[inline(always)]
     pub fn interpolate<T>(&self, data: &[T], tri: u32, b1: f32, b2: f32) -> Option<T>
     where
         T: Copy + std::ops::Mul<f32, Output = T> + std::ops::Add<Output = T>,
@@ -118,7 +119,7 @@ impl Mesh {
     }
 
     /// Interpolated unit shading normal, or `None` without vertex normals (or where they cancel).
-    #[inline]
+    #[inline(always)]
     pub fn shading_normal(&self, tri: u32, b1: f32, b2: f32) -> Option<Vec3> {
         let s = self.interpolate(&self.normals, tri, b1, b2)?;
         let l = s.length();

@@ -103,6 +103,12 @@ impl Program {
         &scratch.set
     }
 
+    /// The closures of a program that does not depend on the shading point.
+    #[inline(always)]
+    pub fn constant_set(&self) -> Option<&ClosureSet> {
+        self.constant.as_ref()
+    }
+
     /// Runs the operations into `scratch` (even for a constant program).
     pub(crate) fn run(&self, g: &ShaderGlobals, env: &ShadeEnv, scratch: &mut Scratch) {
         scratch.slots.clear();
