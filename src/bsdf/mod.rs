@@ -17,7 +17,7 @@ use glam::{Vec2, Vec3};
 
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
-pub use microfacet::RoughConductor;
+pub use microfacet::{ConductorFresnel, RoughConductor, Roughness};
 pub use mirror::Mirror;
 pub use plastic::Plastic;
 
