@@ -20,7 +20,7 @@
 use super::microfacet::Roughness;
 use super::rough_dielectric::RoughDielectric;
 use super::sheen::Sheen;
-use super::tables::dielectric_reflection_albedo;
+use super::tables::{dielectric_reflection_albedo, ggx_e, reflection_fresnel_s};
 use super::{
     Bsdf, BsdfQueryRecord, DELTA_ALPHA, Dielectric, Diffuse, Measure, Mirror, Plastic,
     RoughConductor, Translucent, fresnel,
@@ -36,10 +36,13 @@ pub trait Layer: Bsdf {
 }
 
 /// The Principled BSDF's coat: a GGX reflection with the dielectric Fresnel of the coat IOR
-/// (Cycles' `MicrofacetFresnel::DIELECTRIC`), weighted by Coat Weight, over a base attenuated
-/// by `(1 - weight · F̄(μ)) · mix(1, tint^(1/cos θt), weight)`, where `F̄` is Cycles' Fresnel
-/// estimate of the coat lobe ([`dielectric_reflection_albedo`]) and `cos θt` the cosine of `wi`
-/// refracted into the coat (Beer's law through a coat of unit thickness).
+/// (Cycles' `MicrofacetFresnel::DIELECTRIC`), weighted by Coat Weight and always energy
+/// compensated (Cycles' `bsdf_microfacet_setup_fresnel_dielectric` does so whatever the
+/// distribution), over a base attenuated by `(1 - weight · F̂(μ) · darkening(μ)) ·
+/// mix(1, tint^(1/cos θt), weight)`, where `F̂` is Cycles' Fresnel estimate of the coat lobe
+/// ([`dielectric_reflection_albedo`]), `darkening` its energy-compensation term (see
+/// `impl Layer for RoughDielectric`) and `cos θt` the cosine of `wi` refracted into the coat
+/// (Beer's law through a coat of unit thickness).
 ///
 /// Below [`DELTA_ALPHA`] the coat is a delta reflection of weight `weight · F(μ)`.
 #[derive(Clone, Copy, Debug)]
@@ -67,7 +70,8 @@ impl Coat {
             ior,
             alpha,
             tint: tint.max(Vec3::ZERO),
-            lobe: RoughDielectric::reflection(Vec3::splat(weight), ior, alpha, alpha),
+            lobe: RoughDielectric::reflection(Vec3::splat(weight), ior, alpha, alpha)
+                .multiscatter(),
         }
     }
 
@@ -88,25 +92,61 @@ impl Coat {
 
 impl Layer for Coat {
     fn albedo(&self, wi: Vec3) -> Vec3 {
-        if wi.z <= 0.0 {
-            return Vec3::ZERO;
-        }
-        Vec3::splat(self.weight * dielectric_reflection_albedo(self.alpha, wi.z, self.ior))
+        Layer::albedo(&self.lobe, wi)
     }
 
     fn attenuation(&self, wi: Vec3) -> Vec3 {
         if wi.z <= 0.0 {
             return Vec3::ONE;
         }
-        let mu = wi.z.min(1.0);
-        let a = (1.0 - self.albedo(wi).x).clamp(0.0, 1.0);
+        let a = self.lobe.attenuation(wi);
         if self.tint == Vec3::ONE {
-            return Vec3::splat(a);
+            return a;
         }
+        let mu = wi.z.min(1.0);
         let inv = 1.0 / self.ior;
         let cos_t = (1.0 - inv * inv * (1.0 - mu * mu)).max(0.0).sqrt();
         let through = self.tint.powf(1.0 / cos_t);
         a * (Vec3::ONE + (through - Vec3::ONE) * self.weight)
+    }
+}
+
+/// A reflection-only dielectric lobe as a layer (Principled's specular layer over diffuse,
+/// and the coat): Cycles' albedo estimate `reflection_tint ⊙ F̂(μ) ⊙ darkening(μ)`, with
+/// `F̂ = mix(F0 · f0_tint, 1, s(√α, μ, z))` from the `ggx_gen_schlick_ior_s` table
+/// ([`super::tables::reflection_fresnel_s`]; for `f0_tint = 1` and `ior ≤ 1` Cycles uses the
+/// smooth Fresnel reflectance, as here) and, with energy compensation, Cycles' darkening
+/// `factor · E(μ)` folded into the closure weight. The layers below are scaled by
+/// `1 - max(albedo)`.
+impl Layer for RoughDielectric {
+    fn albedo(&self, wi: Vec3) -> Vec3 {
+        if wi.z <= 0.0 || self.mode != super::DielectricMode::Reflection {
+            return Vec3::ZERO;
+        }
+        let mu = wi.z.min(1.0);
+        let alpha = (self.roughness.alpha_x * self.roughness.alpha_y).sqrt();
+        let f = if self.f0_tint == Vec3::ONE {
+            Vec3::splat(dielectric_reflection_albedo(alpha, mu, self.ior))
+        } else {
+            let f0 = (fresnel::f0_from_ior(self.ior) * self.f0_tint).min(Vec3::ONE);
+            let s = reflection_fresnel_s(alpha, mu, self.ior);
+            f0 + (Vec3::ONE - f0) * s
+        };
+        let darkening = match self.multiscatter_fss {
+            Some(_) => {
+                let (e, _) = ggx_e(self.roughness.alpha_x, self.roughness.alpha_y, mu);
+                self.energy_factor(mu, self.ior) * e
+            }
+            None => Vec3::ONE,
+        };
+        self.reflection_tint * f * darkening
+    }
+
+    fn attenuation(&self, wi: Vec3) -> Vec3 {
+        if wi.z <= 0.0 {
+            return Vec3::ONE;
+        }
+        Vec3::splat((1.0 - Layer::albedo(self, wi).max_element()).clamp(0.0, 1.0))
     }
 }
 
@@ -255,6 +295,8 @@ impl<T: Layer, B: Bsdf> Bsdf for Layered<T, B> {
 pub enum TopLobe {
     Coat(Coat),
     Sheen(Sheen),
+    /// A reflection-only [`RoughDielectric`] (Principled's specular layer).
+    Specular(RoughDielectric),
 }
 
 /// The lobes that can lie below a [`TopLobe`].
@@ -271,6 +313,8 @@ pub enum BaseLobe {
     /// (`Layered<Sheen, Layered<Coat, _>>`), given here over a diffuse base.
     CoatedDiffuse(Layered<Coat, Diffuse>),
     CoatedConductor(Layered<Coat, RoughConductor>),
+    /// Principled's dielectric base: the specular layer over diffuse.
+    SpecularDiffuse(Layered<RoughDielectric, Diffuse>),
 }
 
 macro_rules! dispatch_top {
@@ -278,6 +322,7 @@ macro_rules! dispatch_top {
         match $self {
             TopLobe::Coat($b) => $e,
             TopLobe::Sheen($b) => $e,
+            TopLobe::Specular($b) => $e,
         }
     };
 }
@@ -294,6 +339,7 @@ macro_rules! dispatch_base {
             BaseLobe::Translucent($b) => $e,
             BaseLobe::CoatedDiffuse($b) => $e,
             BaseLobe::CoatedConductor($b) => $e,
+            BaseLobe::SpecularDiffuse($b) => $e,
         }
     };
 }

@@ -8,7 +8,7 @@
 //! normalised: ∫ D(h) cos θh dh = 1); `G1`/`G2` are Smith's masking and height-correlated
 //! masking-shadowing functions.
 
-use super::{Bsdf, BsdfQueryRecord, Measure, fresnel};
+use super::{Bsdf, BsdfQueryRecord, Measure, fresnel, tables};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -324,6 +324,16 @@ impl ConductorFresnel {
         ConductorFresnel::F82 { f0, b }
     }
 
+    /// The average single-scattering reflectance `F_ss` Cycles uses for the multiple-bounce
+    /// Fresnel: `mix(F0, 1, 1/21) - b/126` (exact for Schlick/F82), or the constant colour.
+    pub fn fss(&self) -> Vec3 {
+        match *self {
+            ConductorFresnel::Schlick(f0) => f0 + (Vec3::ONE - f0) / 21.0,
+            ConductorFresnel::Constant(c) => c,
+            ConductorFresnel::F82 { f0, b } => f0 + (Vec3::ONE - f0) / 21.0 - b / 126.0,
+        }
+    }
+
     /// The reflectance at `cos = wi·h`.
     #[inline]
     pub fn eval(&self, cos: f32) -> Vec3 {
@@ -343,10 +353,15 @@ impl ConductorFresnel {
 /// A rough conductor: `f = F(wi·h) D(h) G2 / (4 cos θi cos θo)` with GGX, isotropic or
 /// anisotropic (alpha_x along local +X, the tangent), and the reflectance of
 /// [`ConductorFresnel`]. Reflects on the +Z side only.
+///
+/// With `multiscatter` (Cycles' "Multiscatter GGX", the Principled default), `f` is scaled by
+/// [`tables::multiscatter_factor`]`(E(μ), E_avg, F_ss)`, Cycles' energy compensation of the
+/// single-scattering loss (the sampled directions and the pdf are unchanged).
 #[derive(Clone, Copy, Debug)]
 pub struct RoughConductor {
     pub roughness: Roughness,
     pub fresnel: ConductorFresnel,
+    pub multiscatter: bool,
 }
 
 impl RoughConductor {
@@ -355,6 +370,7 @@ impl RoughConductor {
         RoughConductor {
             roughness: Roughness::isotropic(alpha),
             fresnel: ConductorFresnel::Schlick(f0),
+            multiscatter: false,
         }
     }
 
@@ -363,7 +379,26 @@ impl RoughConductor {
         RoughConductor {
             roughness: Roughness::new(alpha_x, alpha_y),
             fresnel,
+            multiscatter: false,
         }
+    }
+
+    /// The same lobe with Cycles' Multiscatter GGX energy compensation.
+    pub fn multiscatter(self) -> Self {
+        RoughConductor {
+            multiscatter: true,
+            ..self
+        }
+    }
+
+    /// The energy-compensation factor for this `wi` (1 without `multiscatter`).
+    #[inline]
+    pub fn energy_factor(&self, wi: Vec3) -> Vec3 {
+        if !self.multiscatter {
+            return Vec3::ONE;
+        }
+        let (e, e_avg) = tables::ggx_e(self.roughness.alpha_x, self.roughness.alpha_y, wi.z);
+        tables::multiscatter_factor(e, e_avg, self.fresnel.fss())
     }
 
     /// Blender's Glossy BSDF (distribution GGX): `color` = Color input, `(alpha_x, alpha_y)`
@@ -398,7 +433,13 @@ impl Bsdf for RoughConductor {
         rec.measure = Measure::SolidAngle;
         let h = (rec.wi + wo).normalize();
         // f cos / pdf = F G2 / G1(wi)
-        self.fresnel.eval(rec.wi.dot(h)) * self.roughness.g2(rec.wi, wo) / self.roughness.g1(rec.wi)
+        let w = self.fresnel.eval(rec.wi.dot(h)) * self.roughness.g2(rec.wi, wo)
+            / self.roughness.g1(rec.wi);
+        if self.multiscatter {
+            w * self.energy_factor(rec.wi)
+        } else {
+            w
+        }
     }
 
     fn eval(&self, rec: &BsdfQueryRecord) -> Vec3 {
@@ -407,8 +448,13 @@ impl Bsdf for RoughConductor {
             return Vec3::ZERO;
         }
         let h = (wi + wo).normalize();
-        self.fresnel.eval(wi.dot(h)) * self.roughness.d(h) * self.roughness.g2(wi, wo)
-            / (4.0 * wi.z * wo.z)
+        let f = self.fresnel.eval(wi.dot(h)) * self.roughness.d(h) * self.roughness.g2(wi, wo)
+            / (4.0 * wi.z * wo.z);
+        if self.multiscatter {
+            f * self.energy_factor(wi)
+        } else {
+            f
+        }
     }
 
     fn pdf(&self, rec: &BsdfQueryRecord) -> f32 {

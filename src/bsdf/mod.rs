@@ -27,7 +27,7 @@ pub use layered::{BaseLobe, Coat, Layer, Layered, TopLobe};
 pub use microfacet::{ConductorFresnel, RoughConductor, Roughness};
 pub use mirror::Mirror;
 pub use plastic::Plastic;
-pub use rough_dielectric::{DielectricMode, RoughDielectric};
+pub use rough_dielectric::{DielectricMode, RoughDielectric, principled_specular_ior};
 pub use sheen::Sheen;
 pub use translucent::Translucent;
 pub use transparent::Transparent;

@@ -19,12 +19,15 @@
 //! refraction's weight is `T G2 / (G1(wi) P_t)`. Sampling picks reflection with Cycles'
 //! probability `P_r = avg(R) / avg(R + T)` at the sampled microfacet.
 //!
-//! This is single scattering: light that would scatter between microfacets is lost (Cycles'
-//! "GGX" distribution). Cycles' "Multiscatter GGX" (the Principled and Glass default) adds an
-//! energy compensation that is not modelled here.
+//! By default this is single scattering: light that would scatter between microfacets is lost
+//! (Cycles' "GGX" distribution). [`RoughDielectric::multiscatter`] adds Cycles' "Multiscatter
+//! GGX" energy compensation (the Principled default): `f` scaled by
+//! [`tables::multiscatter_factor`]`(E(μ), E_avg, F_ss)` with the glass tables (Glass) or the
+//! mirror tables (Reflection), and `F_ss` chosen as Cycles does (the transmission tint for
+//! glass, the average Fresnel for reflection).
 
 use super::microfacet::Roughness;
-use super::{Bsdf, BsdfQueryRecord, Measure, fresnel};
+use super::{Bsdf, BsdfQueryRecord, Measure, fresnel, tables};
 use glam::{Vec2, Vec3};
 
 /// Which lobes a [`RoughDielectric`] has.
@@ -53,6 +56,8 @@ pub struct RoughDielectric {
     pub f0_tint: Vec3,
     pub reflection_tint: Vec3,
     pub transmission_tint: Vec3,
+    /// `F_ss` of Cycles' energy compensation, when enabled ([`RoughDielectric::multiscatter`]).
+    pub multiscatter_fss: Option<Vec3>,
 }
 
 /// Relative index within this distance of 1 makes refraction a pass-through (Cycles treats it
@@ -83,7 +88,51 @@ impl RoughDielectric {
             f0_tint: Vec3::ONE,
             reflection_tint: reflection_tint.max(Vec3::ZERO),
             transmission_tint: transmission_tint.max(Vec3::ZERO),
+            multiscatter_fss: None,
         }
+    }
+
+    /// The same lobe with Cycles' Multiscatter GGX energy compensation (Glass and Reflection
+    /// modes; Cycles' Refraction BSDF has none, so that mode is returned unchanged). `F_ss` as
+    /// in Cycles' `bsdf_microfacet_setup_fresnel_*`: the transmission tint for glass; for
+    /// reflection `mix(F0·k, 1, s)` with `s = (F̄ - F0) / (1 - F0)`, `F̄` the hemispherical
+    /// average Fresnel ([`tables::fresnel_dielectric_fss`]); the reflection tint is treated as
+    /// the closure's weight, not part of `F_ss`.
+    pub fn multiscatter(self) -> Self {
+        let fss = match self.mode {
+            DielectricMode::Refraction => return self,
+            DielectricMode::Glass => self.transmission_tint,
+            DielectricMode::Reflection => {
+                let f0 = fresnel::f0_from_ior(self.ior);
+                let fbar = tables::fresnel_dielectric_fss(self.ior);
+                let s = if f0 < 1.0 {
+                    ((fbar - f0) / (1.0 - f0)).clamp(0.0, 1.0)
+                } else {
+                    1.0
+                };
+                let f0t = (f0 * self.f0_tint).min(Vec3::ONE);
+                f0t + (Vec3::ONE - f0t) * s
+            }
+        };
+        RoughDielectric {
+            multiscatter_fss: Some(fss),
+            ..self
+        }
+    }
+
+    /// The energy-compensation factor for `wi` (mirrored to `wi.z > 0`) and relative index
+    /// `eta`; 1 without compensation.
+    #[inline]
+    pub fn energy_factor(&self, wi_z: f32, eta: f32) -> Vec3 {
+        let Some(fss) = self.multiscatter_fss else {
+            return Vec3::ONE;
+        };
+        let a = &self.roughness;
+        let (e, e_avg) = match self.mode {
+            DielectricMode::Glass => tables::ggx_glass_e((a.alpha_x * a.alpha_y).sqrt(), wi_z, eta),
+            _ => tables::ggx_e(a.alpha_x, a.alpha_y, wi_z),
+        };
+        tables::multiscatter_factor(e, e_avg, fss)
     }
 
     /// Blender's Glass BSDF (GGX): Color tints reflection and refraction alike (Cycles sets
@@ -125,6 +174,18 @@ impl RoughDielectric {
             Vec3::ZERO,
             color,
         )
+    }
+
+    /// Principled BSDF's specular layer (dielectric base): reflection only, `F0` scaled by
+    /// Specular Tint, with the IOR from [`principled_specular_ior`]`(IOR, Specular IOR Level)`
+    /// and `(alpha_x, alpha_y)` from [`super::microfacet::anisotropy::principled`]. Layer it over
+    /// the diffuse base with [`super::Layered`]; add [`RoughDielectric::multiscatter`] for
+    /// Cycles' default distribution.
+    pub fn principled_specular(specular_tint: Vec3, ior: f32, alpha_x: f32, alpha_y: f32) -> Self {
+        RoughDielectric {
+            f0_tint: specular_tint.max(Vec3::ZERO),
+            ..RoughDielectric::reflection(Vec3::ONE, ior, alpha_x, alpha_y)
+        }
     }
 
     /// A reflection-only lobe with the dielectric Fresnel of `ior`, tinted by `tint`
@@ -229,7 +290,10 @@ impl RoughDielectric {
             };
             let d = a.d(h);
             let f = r * d * a.g2(wi, wo) / (4.0 * wi.z * wo.z);
-            (f, pr * a.g1(wi) * d / (4.0 * wi.z))
+            (
+                f * self.energy_factor(wi.z, eta),
+                pr * a.g1(wi) * d / (4.0 * wi.z),
+            )
         } else {
             if self.mode == DielectricMode::Reflection || (eta - 1.0).abs() < ETA_ONE {
                 return zero;
@@ -246,9 +310,25 @@ impl RoughDielectric {
             let jac = eta * eta * (-ho) / (denom * denom);
             let d = a.d(h);
             let f = t * d * a.g2(wi, wo) * hi * jac / (wi.z * -wo.z);
-            (f, (1.0 - pr) * a.g1(wi) * hi * d / wi.z * jac)
+            (
+                f * self.energy_factor(wi.z, eta),
+                (1.0 - pr) * a.g1(wi) * hi * d / wi.z * jac,
+            )
         }
     }
+}
+
+/// Cycles' Specular IOR Level adjustment (`svm/closure.h`): `F0(ior)` scaled by `2 · level`
+/// and turned back into an IOR (`level` 0.5 keeps `ior`; 0 gives 1, no specular layer).
+pub fn principled_specular_ior(ior: f32, level: f32) -> f32 {
+    let ior = ior.max(1e-5);
+    let level = level.max(0.0);
+    if level == 0.5 {
+        return ior;
+    }
+    let f0 = fresnel::f0_from_ior(ior) * 2.0 * level;
+    let eta = super::tables::ior_from_f0(f0);
+    if ior < 1.0 { 1.0 / eta } else { eta }
 }
 
 #[inline]
@@ -289,7 +369,7 @@ impl Bsdf for RoughDielectric {
                 rec.pdf = 0.0;
                 rec.eta = 1.0;
                 rec.measure = Measure::Discrete;
-                return t / (1.0 - pr);
+                return t / (1.0 - pr) * self.energy_factor(wi.z, eta);
             }
             let wo = ((c / eta - cos_t) * h - wi / eta).normalize();
             if wo.z >= 0.0 || wo.dot(h) >= 0.0 {
