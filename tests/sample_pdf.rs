@@ -248,6 +248,33 @@ fn blender_lobes_sample_pdf_and_weight_agree() {
             false,
         );
     }
+    for alpha in [0.01f32, 0.2, 0.7, 1.0] {
+        run(
+            format!("multiscatter F82 alpha={alpha}"),
+            &RoughConductor::f82(c, Vec3::new(0.5, 0.8, 1.0), alpha, 0.6 * alpha).multiscatter(),
+            false,
+        );
+        run(
+            format!("multiscatter Glossy alpha={alpha}"),
+            &RoughConductor::glossy(c, alpha, alpha).multiscatter(),
+            false,
+        );
+        for ior in [1.5f32, 0.7] {
+            run(
+                format!("multiscatter glass ior={ior} alpha={alpha}"),
+                &RoughDielectric::glass(c, ior, alpha).multiscatter(),
+                true,
+            );
+        }
+        run(
+            format!("multiscatter specular over diffuse alpha={alpha}"),
+            &Layered::new(
+                RoughDielectric::principled_specular(c, 1.5, alpha, alpha).multiscatter(),
+                Diffuse::new(c),
+            ),
+            false,
+        );
+    }
     run("Translucent".into(), &Translucent::new(c), true);
     for r in [0.01f32, 0.2, 0.5, 1.0] {
         run(format!("Sheen r={r}"), &Sheen::new(c, r), false);
