@@ -10,9 +10,13 @@ mod chi2_common;
 use chi2_common::*;
 use glam::{DVec3, Vec2, Vec3};
 use std::f64::consts::PI;
-use tesela::bsdf::microfacet::{ggx_d, ggx_g1, sample_visible_normal};
+use tesela::bsdf::microfacet::{
+    anisotropy, ggx_d, ggx_d_aniso, ggx_g1, ggx_g1_aniso, sample_visible_normal,
+    sample_visible_normal_aniso,
+};
 use tesela::bsdf::{
-    Bsdf, BsdfQueryRecord, Dielectric, Diffuse, Measure, Mirror, Plastic, RoughConductor,
+    Bsdf, BsdfQueryRecord, Coat, ConductorFresnel, Dielectric, Diffuse, Layered, Measure, Mirror,
+    Plastic, RoughConductor, RoughDielectric, Sheen, Translucent, Transparent,
 };
 use tesela::emitter::{
     AreaEmitter, Background, Directional, Emitter, EmitterQueryRecord, LightChoice, LightSampler,
@@ -1168,4 +1172,366 @@ fn dense_mesh_emitter_triangle_probabilities_match_areas() {
         c += p;
     }
     assert!(below_2_24 > 0, "the mesh must have triangles below 2^-24");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Lobes of Blender's shader nodes: anisotropic GGX, rough dielectric, translucent, transparent,
+// sheen, and the coat/sheen layering.
+
+/// Anisotropic visible-normal density `G1(wi) max(0, wi·h) D(h) / wi.z`, all from the closed
+/// forms in f64 (D and Λ with the stretched tangent), independent of the library's.
+fn visible_normal_pdf_aniso_reference(wi: Vec3, h: Vec3, ax: f64, ay: f64) -> f64 {
+    let (wi, h) = (wi.as_dvec3(), h.as_dvec3());
+    if h.z <= 0.0 {
+        return 0.0;
+    }
+    let l = (h.x / ax).powi(2) + (h.y / ay).powi(2) + h.z * h.z;
+    let d = 1.0 / (PI * ax * ay * l * l);
+    let lambda =
+        0.5 * (-1.0 + (1.0 + ((ax * wi.x).powi(2) + (ay * wi.y).powi(2)) / (wi.z * wi.z)).sqrt());
+    wi.dot(h).max(0.0) * d / ((1.0 + lambda) * wi.z)
+}
+
+#[test]
+fn ggx_anisotropic_closed_forms_and_visible_normals() {
+    // Isotropic alphas reproduce the isotropic functions.
+    let mut rng = Sampler::new(1200, 0, 0);
+    for _ in 0..2000 {
+        let w = square_to_uniform_sphere(rng.next_2d());
+        let w = Vec3::new(w.x, w.y, w.z.abs().max(1e-3)).normalize();
+        for a in [0.05f32, 0.4, 1.0] {
+            let (d, di) = (ggx_d_aniso(w, a, a), ggx_d(w, a));
+            assert!((d - di).abs() <= 1e-4 * di + 1e-9, "D {d} vs {di}");
+            assert!((ggx_g1_aniso(w, a, a) - ggx_g1(w, a)).abs() < 1e-6);
+        }
+    }
+    let cases = [(0.05f32, 0.3f32), (0.4, 0.1), (0.9, 0.3), (1.0, 0.5)];
+    let thetas = [0.0, 45.0, 80.0, 89.0];
+    let alpha_case = sidak(SIGNIFICANCE, cases.len() * thetas.len());
+    let mut seed = 1210;
+    for &(ax, ay) in &cases {
+        for &theta in &thetas {
+            // Rotated in azimuth, so wi is not aligned with an axis of the anisotropy.
+            let wi = dir_at(theta);
+            let gamma = if ax.min(ay) < 0.2 { 2.0 } else { 1.0 };
+            let grid = DirGrid::new(Vec3::Z, PI / 2.0, gamma, 30, 60);
+            seed += 1;
+            let r = check_directions(
+                &format!("aniso visible normals ax={ax} ay={ay} θi={theta}°"),
+                &grid,
+                N / 2,
+                seed,
+                &mut |s| Some(sample_visible_normal_aniso(wi, ax, ay, s.next_2d())),
+                &|h| visible_normal_pdf_aniso_reference(wi, h, ax as f64, ay as f64),
+                alpha_case,
+            );
+            assert!((r.integral - 1.0).abs() < 2e-3, "∫D_wi = {}", r.integral);
+        }
+    }
+}
+
+#[test]
+fn anisotropic_conductor_sampling() {
+    let f0 = Vec3::new(0.9, 0.6, 0.3);
+    let (gx, gy) = anisotropy::glossy(0.5, 0.8);
+    let (px, py) = anisotropy::principled(0.3, 1.0);
+    let lobes = [
+        ("Glossy r=0.5 aniso=0.8", RoughConductor::glossy(f0, gx, gy)),
+        (
+            "F82 r=0.3 aniso=1",
+            RoughConductor::f82(f0, Vec3::new(1.0, 0.5, 0.2), px, py),
+        ),
+        (
+            "Schlick ax=0.6 ay=0.15",
+            RoughConductor::with(0.6, 0.15, ConductorFresnel::Schlick(f0)),
+        ),
+    ];
+    let thetas = [0.0, 50.0, 85.0];
+    let alpha_case = sidak(SIGNIFICANCE, lobes.len() * thetas.len());
+    let mut seed = 1300;
+    for (name, b) in &lobes {
+        for &theta in &thetas {
+            let wi = dir_at(theta);
+            seed += 1;
+            let r = check_bsdf(
+                &format!("RoughConductor {name} θi={theta}°"),
+                b,
+                wi,
+                &DirGrid::new(mirror_dir(wi), PI, 1.5, 40, 60),
+                seed,
+                alpha_case,
+            );
+            assert!(r.integral <= 1.0 + 1e-3, "∫pdf = {}", r.integral);
+            assert!((r.integral + r.rest_fraction - 1.0).abs() < 0.01);
+        }
+    }
+}
+
+/// The direction refracted from `wi` through the smooth interface (`ior` = inside/outside,
+/// `wi.z < 0` leaving), or the mirror direction on total internal reflection.
+fn refracted_or_mirror(wi: Vec3, ior: f32) -> Vec3 {
+    let eta = if wi.z < 0.0 { 1.0 / ior } else { ior };
+    let sin2 = (1.0 - wi.z * wi.z) / (eta * eta);
+    if sin2 >= 1.0 {
+        return mirror_dir(wi);
+    }
+    Vec3::new(
+        -wi.x / eta,
+        -wi.y / eta,
+        -wi.z.signum() * (1.0 - sin2).sqrt(),
+    )
+    .normalize()
+}
+
+#[test]
+fn rough_dielectric_sampling() {
+    // Glass from outside (entering) and inside (leaving), IOR above and below 1 (0.8 models a
+    // bubble), grazing incidence, tinted reflection vs refraction (the choice probability
+    // follows the tints as in Cycles) and Principled's F0 tint.
+    let tint = Vec3::new(0.9, 0.5, 0.2);
+    let lobes = [
+        (
+            "glass 1.5 a=0.1",
+            RoughDielectric::glass(Vec3::ONE, 1.5, 0.1),
+        ),
+        ("glass 1.5 a=0.5", RoughDielectric::glass(tint, 1.5, 0.5)),
+        (
+            "glass 1.33 a=1",
+            RoughDielectric::glass(Vec3::ONE, 1.33, 1.0),
+        ),
+        (
+            "glass 0.8 a=0.3",
+            RoughDielectric::glass(Vec3::ONE, 0.8, 0.3),
+        ),
+        (
+            "principled 2.4 a=0.25",
+            RoughDielectric::principled_transmission(tint, Vec3::new(1.0, 0.3, 0.6), 2.4, 0.25),
+        ),
+        (
+            "aniso reflection-only 1.5 ax=0.4 ay=0.1",
+            RoughDielectric::reflection(tint, 1.5, 0.4, 0.1),
+        ),
+    ];
+    let thetas = [0.0f64, 60.0, 87.0, -30.0, -70.0];
+    let alpha_case = sidak(SIGNIFICANCE, lobes.len() * thetas.len());
+    let mut seed = 1400;
+    for (name, b) in &lobes {
+        for &theta in &thetas {
+            let mut wi = dir_at(theta.abs());
+            if theta < 0.0 {
+                wi.z = -wi.z;
+            }
+            seed += 1;
+            let centre = refracted_or_mirror(wi, b.ior);
+            let gamma = if b.roughness.alpha_x < 0.2 { 2.0 } else { 1.0 };
+            let r = check_bsdf(
+                &format!("RoughDielectric {name} θi={theta}°"),
+                b,
+                wi,
+                &DirGrid::new(centre, PI, gamma, 40, 60),
+                seed,
+                alpha_case,
+            );
+            assert!(r.integral <= 1.0 + 1e-3, "∫pdf = {}", r.integral);
+            assert!((r.integral + r.rest_fraction - 1.0).abs() < 0.01);
+        }
+    }
+}
+
+#[test]
+fn refraction_bsdf_sampling() {
+    let lobes = [
+        (
+            "1.45 a=0.2",
+            RoughDielectric::refraction(Vec3::ONE, 1.45, 0.2),
+        ),
+        (
+            "1.45 a=0.8",
+            RoughDielectric::refraction(Vec3::splat(0.5), 1.45, 0.8),
+        ),
+        (
+            "0.7 a=0.4",
+            RoughDielectric::refraction(Vec3::ONE, 0.7, 0.4),
+        ),
+    ];
+    let thetas = [10.0f64, 75.0, -40.0, -80.0];
+    let alpha_case = sidak(SIGNIFICANCE, lobes.len() * thetas.len());
+    let mut seed = 1500;
+    for (name, b) in &lobes {
+        for &theta in &thetas {
+            let mut wi = dir_at(theta.abs());
+            if theta < 0.0 {
+                wi.z = -wi.z;
+            }
+            seed += 1;
+            let r = check_bsdf(
+                &format!("Refraction {name} θi={theta}°"),
+                b,
+                wi,
+                &DirGrid::new(refracted_or_mirror(wi, b.ior), PI, 1.0, 40, 60),
+                seed,
+                alpha_case,
+            );
+            assert!(r.integral <= 1.0 + 1e-3, "∫pdf = {}", r.integral);
+        }
+    }
+}
+
+/// A rough dielectric whose `pdf()` misses one factor `η` in the refraction Jacobian
+/// `η² |wo·h| / (wi·h + η wo·h)²` (the error the chi-square test must catch).
+struct BrokenJacobian(RoughDielectric);
+
+impl Bsdf for BrokenJacobian {
+    fn sample(&self, rec: &mut BsdfQueryRecord, u: Vec2, u1: f32) -> Vec3 {
+        self.0.sample(rec, u, u1)
+    }
+    fn eval(&self, rec: &BsdfQueryRecord) -> Vec3 {
+        self.0.eval(rec)
+    }
+    fn pdf(&self, rec: &BsdfQueryRecord) -> f32 {
+        let p = self.0.pdf(rec);
+        if rec.wi.z * rec.wo.z < 0.0 {
+            let eta = if rec.wi.z < 0.0 {
+                1.0 / self.0.ior
+            } else {
+                self.0.ior
+            };
+            p / eta
+        } else {
+            p
+        }
+    }
+    fn is_delta(&self) -> bool {
+        false
+    }
+}
+
+#[test]
+fn chi2_rejects_a_wrong_refraction_jacobian() {
+    let b = BrokenJacobian(RoughDielectric::glass(Vec3::ONE, 1.5, 0.3));
+    let wi = dir_at(40.0);
+    let grid = DirGrid::new(refracted_or_mirror(wi, 1.5), PI, 1.0, 40, 60);
+    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        check_bsdf("broken Jacobian", &b, wi, &grid, 1600, SIGNIFICANCE)
+    }));
+    assert!(r.is_err(), "a pdf off by η on refraction passed the test");
+}
+
+#[test]
+fn translucent_sampling() {
+    let b = Translucent::new(Vec3::new(0.8, 0.5, 0.2));
+    let thetas = [30.0f64, 89.0, -60.0];
+    let alpha_case = sidak(SIGNIFICANCE, thetas.len());
+    for (k, &theta) in thetas.iter().enumerate() {
+        let mut wi = dir_at(theta.abs());
+        if theta < 0.0 {
+            wi.z = -wi.z;
+        }
+        let r = check_bsdf(
+            &format!("Translucent θi={theta}°"),
+            &b,
+            wi,
+            &DirGrid::sphere(40, 80),
+            1702 + k as u64,
+            alpha_case,
+        );
+        assert!((r.integral - 1.0).abs() < 1e-4, "∫pdf = {}", r.integral);
+        assert_eq!(r.rest_fraction, 0.0);
+    }
+}
+
+#[test]
+fn transparent_passes_straight_through() {
+    let c = Vec3::new(0.3, 0.6, 0.9);
+    let b = Transparent::new(c);
+    assert!(b.is_delta());
+    let mut rng = Sampler::new(1750, 0, 0);
+    for _ in 0..10_000 {
+        let wi = square_to_uniform_sphere(rng.next_2d());
+        let mut rec = BsdfQueryRecord::new(wi);
+        let w = b.sample(&mut rec, rng.next_2d(), rng.next_1d());
+        assert_eq!(w, c);
+        assert_eq!(rec.wo, -wi);
+        assert_eq!(rec.measure, Measure::Discrete);
+        assert_eq!((rec.eta, rec.pdf), (1.0, 0.0));
+        let pair = BsdfQueryRecord::pair(wi, rec.wo);
+        assert_eq!((b.eval(&pair), b.pdf(&pair)), (Vec3::ZERO, 0.0));
+    }
+}
+
+#[test]
+fn sheen_sampling() {
+    let rough = [0.05f32, 0.3, 0.6, 1.0];
+    let thetas = [0.0, 45.0, 80.0, 88.0];
+    let alpha_case = sidak(SIGNIFICANCE, rough.len() * thetas.len());
+    let mut seed = 1800;
+    for &r in &rough {
+        for &theta in &thetas {
+            let wi = dir_at(theta);
+            let b = Sheen::new(Vec3::new(1.0, 0.8, 0.6), r);
+            seed += 1;
+            if b.albedo(wi) == Vec3::ZERO {
+                // Cycles drops the lobe here (invalid LTC): sampling always fails.
+                let mut rng = Sampler::new(seed, 0, 0);
+                for _ in 0..1000 {
+                    let mut rec = BsdfQueryRecord::new(wi);
+                    assert_eq!(b.sample(&mut rec, rng.next_2d(), 0.5), Vec3::ZERO);
+                }
+                println!("Sheen r={r} θi={theta}°: dropped (albedo 0)");
+                continue;
+            }
+            let res = check_bsdf(
+                &format!("Sheen r={r} θi={theta}°"),
+                &b,
+                wi,
+                &DirGrid::sphere(40, 80),
+                seed,
+                alpha_case,
+            );
+            assert!((res.integral - 1.0).abs() < 2e-3, "∫pdf = {}", res.integral);
+        }
+    }
+}
+
+#[test]
+fn layered_sampling() {
+    let base = Diffuse::new(Vec3::new(0.7, 0.3, 0.1));
+    let metal = RoughConductor::f82(Vec3::new(0.9, 0.6, 0.4), Vec3::ONE, 0.4, 0.4);
+    let coat = Coat::new(1.0, 0.2, 1.5, Vec3::new(0.9, 0.7, 0.5));
+    let rough_coat = Coat::new(0.6, 0.7, 1.8, Vec3::ONE);
+    let sheen = Sheen::new(Vec3::splat(0.8), 0.5);
+    let smooth_coat = Coat::new(1.0, 0.0, 1.5, Vec3::ONE);
+    let lobes: Vec<(&str, Box<dyn Bsdf>)> = vec![
+        ("coat over diffuse", Box::new(Layered::new(coat, base))),
+        (
+            "rough coat over metal",
+            Box::new(Layered::new(rough_coat, metal)),
+        ),
+        (
+            "sheen over coat over diffuse",
+            Box::new(Layered::new(sheen, Layered::new(coat, base))),
+        ),
+        (
+            "smooth coat over diffuse",
+            Box::new(Layered::new(smooth_coat, base)),
+        ),
+    ];
+    let thetas = [10.0, 60.0, 86.0];
+    let alpha_case = sidak(SIGNIFICANCE, lobes.len() * thetas.len());
+    let mut seed = 1900;
+    for (name, b) in &lobes {
+        for &theta in &thetas {
+            let wi = dir_at(theta);
+            seed += 1;
+            let r = check_bsdf(
+                &format!("Layered {name} θi={theta}°"),
+                b.as_ref(),
+                wi,
+                &DirGrid::new(mirror_dir(wi), PI, 1.5, 40, 60),
+                seed,
+                alpha_case,
+            );
+            assert!(r.integral <= 1.0 + 1e-3, "∫pdf = {}", r.integral);
+        }
+    }
 }

@@ -5,9 +5,11 @@
 //! one-sided emission.
 
 use glam::{Vec2, Vec3};
+use tesela::bsdf::microfacet::anisotropy;
 use tesela::bsdf::{
-    Bsdf, BsdfQueryRecord, Dielectric, Diffuse, Measure, Mirror, Plastic, RoughConductor,
-    SurfaceParams, choose,
+    BaseLobe, Bsdf, BsdfInstance, BsdfQueryRecord, Coat, ConductorFresnel, Dielectric, Diffuse,
+    Layered, Measure, Mirror, Plastic, RoughConductor, RoughDielectric, Sheen, SurfaceParams,
+    TopLobe, Translucent, Transparent, choose,
 };
 use tesela::emitter::{
     AreaEmitter, Directional, Emitter, EmitterInstance, EmitterQueryRecord, LightChoice,
@@ -132,6 +134,276 @@ fn bsdf_sample_pdf_and_weight_agree() {
     }
 }
 
+/// Like [`check_bsdf`] for lobes that may transmit and may be seen from either side: sampled
+/// reflections stay on `wi`'s side and refractions cross; `eta` is 1 for reflections.
+fn check_any_bsdf(name: &str, bsdf: &dyn Bsdf, seed: u64, wi_below: bool) -> usize {
+    let mut rng = Sampler::new(seed, 0, 0);
+    let mut checked = 0;
+    for k in 0..20_000 {
+        let mut wi = incident(&mut rng, k);
+        if !wi_below {
+            wi.z = wi.z.abs();
+        }
+        let mut rec = BsdfQueryRecord::new(wi);
+        let w = bsdf.sample(&mut rec, rng.next_2d(), rng.next_1d());
+        assert!(
+            w.is_finite() && w.min_element() >= 0.0,
+            "{name}: weight {w}"
+        );
+        if w == Vec3::ZERO {
+            continue;
+        }
+        assert!(
+            (rec.wo.length() - 1.0).abs() < 1e-4,
+            "{name}: |wo| = {}",
+            rec.wo.length()
+        );
+        if rec.wo.z * wi.z > 0.0 {
+            assert_eq!(rec.eta, 1.0, "{name}: reflection with eta {}", rec.eta);
+        }
+        let pair = BsdfQueryRecord::pair(wi, rec.wo);
+        match rec.measure {
+            Measure::SolidAngle => {
+                let pdf = bsdf.pdf(&pair);
+                assert!(
+                    rec.pdf > 0.0 && rec.pdf.is_finite(),
+                    "{name}: rec.pdf {}",
+                    rec.pdf
+                );
+                assert!(
+                    close(rec.pdf, pdf, REL),
+                    "{name}: sample reports pdf {} but pdf() = {pdf} (wi {wi}, wo {})",
+                    rec.pdf,
+                    rec.wo
+                );
+                let want = bsdf.eval(&pair) * rec.wo.z.abs() / pdf;
+                assert!(
+                    close3(w, want, REL),
+                    "{name}: weight {w} but eval·cos/pdf = {want} (wi {wi}, wo {})",
+                    rec.wo
+                );
+                checked += 1;
+            }
+            Measure::Discrete => assert_eq!(rec.pdf, 0.0, "{name}: delta sample with a pdf"),
+        }
+    }
+    println!("{name}: {checked} samples checked");
+    checked
+}
+
+#[test]
+fn blender_lobes_sample_pdf_and_weight_agree() {
+    let c = Vec3::new(0.9, 0.5, 0.2);
+    let mut seed = 300;
+    let mut run = |name: String, b: &dyn Bsdf, wi_below: bool| {
+        seed += 1;
+        assert!(!b.is_delta(), "{name}");
+        // Index-matched glass (IOR 1.00005) refracts as a delta: almost nothing to check.
+        let min = if name.contains("1.00005") { 0 } else { 1000 };
+        assert!(
+            check_any_bsdf(&name, b, seed, wi_below) >= min,
+            "{name}: too few samples checked"
+        );
+    };
+    for (r, a) in [(0.2f32, 0.5f32), (0.6, -0.7), (1.0, 0.99), (0.05, 0.3)] {
+        let (ax, ay) = anisotropy::glossy(r, a);
+        run(
+            format!("Glossy r={r} a={a}"),
+            &RoughConductor::glossy(c, ax, ay),
+            false,
+        );
+        let (ax, ay) = anisotropy::principled(r, a.abs());
+        run(
+            format!("F82 r={r} a={a}"),
+            &RoughConductor::f82(c, Vec3::new(0.2, 0.9, 1.0), ax, ay),
+            false,
+        );
+    }
+    for (ior, alpha) in [
+        (1.5f32, 0.002f32),
+        (1.5, 0.1),
+        (1.33, 0.6),
+        (2.4, 1.0),
+        (0.75, 0.3),
+        (1.00005, 0.3),
+    ] {
+        run(
+            format!("Glass ior={ior} alpha={alpha}"),
+            &RoughDielectric::glass(c, ior, alpha),
+            true,
+        );
+        run(
+            format!("Principled transmission ior={ior} alpha={alpha}"),
+            &RoughDielectric::principled_transmission(c, Vec3::new(1.0, 0.2, 0.5), ior, alpha),
+            true,
+        );
+        run(
+            format!("Refraction ior={ior} alpha={alpha}"),
+            &RoughDielectric::refraction(c, ior, alpha),
+            true,
+        );
+        run(
+            format!("dielectric reflection ior={ior} alpha={alpha}"),
+            &RoughDielectric::reflection(c, ior, alpha, 0.5 * alpha),
+            false,
+        );
+    }
+    for alpha in [0.01f32, 0.2, 0.7, 1.0] {
+        run(
+            format!("multiscatter F82 alpha={alpha}"),
+            &RoughConductor::f82(c, Vec3::new(0.5, 0.8, 1.0), alpha, 0.6 * alpha).multiscatter(),
+            false,
+        );
+        run(
+            format!("multiscatter Glossy alpha={alpha}"),
+            &RoughConductor::glossy(c, alpha, alpha).multiscatter(),
+            false,
+        );
+        for ior in [1.5f32, 0.7] {
+            run(
+                format!("multiscatter glass ior={ior} alpha={alpha}"),
+                &RoughDielectric::glass(c, ior, alpha).multiscatter(),
+                true,
+            );
+        }
+        run(
+            format!("multiscatter specular over diffuse alpha={alpha}"),
+            &Layered::new(
+                RoughDielectric::principled_specular(c, 1.5, alpha, alpha).multiscatter(),
+                Diffuse::new(c),
+            ),
+            false,
+        );
+    }
+    run("Translucent".into(), &Translucent::new(c), true);
+    for r in [0.01f32, 0.2, 0.5, 1.0] {
+        run(format!("Sheen r={r}"), &Sheen::new(c, r), false);
+    }
+    let base = Diffuse::new(c);
+    let metal = RoughConductor::f82(c, Vec3::ONE, 0.3, 0.3);
+    for (w, r, ior, tint) in [
+        (1.0f32, 0.0f32, 1.5f32, Vec3::ONE),
+        (1.0, 0.3, 1.5, Vec3::new(0.9, 0.6, 0.3)),
+        (0.4, 0.9, 2.0, Vec3::ONE),
+    ] {
+        let coat = Coat::new(w, r, ior, tint);
+        run(
+            format!("coat {w} {r} over diffuse"),
+            &Layered::new(coat, base),
+            false,
+        );
+        run(
+            format!("coat {w} {r} over metal"),
+            &Layered::new(coat, metal),
+            false,
+        );
+        run(
+            format!("sheen over coat {w} {r} over diffuse"),
+            &Layered::new(Sheen::new(c, 0.5), Layered::new(coat, base)),
+            false,
+        );
+    }
+    // Through the enum: a coat over rough glass, seen from both sides.
+    let glass = RoughDielectric::principled_transmission(c, Vec3::ONE, 1.5, 0.2);
+    let b = BsdfInstance::Layered(Layered::new(
+        TopLobe::Coat(Coat::new(1.0, 0.2, 1.5, Vec3::ONE)),
+        BaseLobe::RoughDielectric(glass),
+    ));
+    assert!(b.is_transmissive());
+    run("Layered coat over glass".into(), &b, true);
+}
+
+/// Reciprocity where it holds: `f(wi, wo) = f(wo, wi)` for the conductors, dielectric
+/// reflection and translucency; for refraction, in Tesela's convention (no `1/η²` radiance
+/// scaling), `f(wi, wo) = (η_o/η_i)² f(wo, wi)`. (The sheen LTC is not reciprocal, in Cycles
+/// either: its lobe is fitted per `wi`.)
+#[test]
+fn bsdf_reciprocity() {
+    let mut rng = Sampler::new(400, 0, 0);
+    let c = Vec3::new(0.9, 0.5, 0.2);
+    let (ax, ay) = anisotropy::principled(0.5, 0.7);
+    let reflective: Vec<(&str, Box<dyn Bsdf>)> = vec![
+        ("Glossy aniso", Box::new(RoughConductor::glossy(c, ax, ay))),
+        (
+            "F82 aniso",
+            Box::new(RoughConductor::f82(c, Vec3::new(0.3, 0.8, 1.0), ax, ay)),
+        ),
+        (
+            "Schlick",
+            Box::new(RoughConductor::with(0.3, 0.3, ConductorFresnel::Schlick(c))),
+        ),
+        (
+            "dielectric reflection",
+            Box::new(RoughDielectric::reflection(c, 1.5, ax, ay)),
+        ),
+        ("Translucent", Box::new(Translucent::new(c))),
+    ];
+    let glass: Vec<(&str, RoughDielectric)> = vec![
+        ("Glass 1.5", RoughDielectric::glass(c, 1.5, 0.3)),
+        ("Glass 0.8", RoughDielectric::glass(Vec3::ONE, 0.8, 0.7)),
+        (
+            "Principled 1.33",
+            RoughDielectric::principled_transmission(c, c, 1.33, 0.2),
+        ),
+    ];
+    let mut n_refr = 0;
+    for _ in 0..20_000 {
+        let wi = square_to_uniform_sphere(rng.next_2d());
+        let wo = square_to_uniform_sphere(rng.next_2d());
+        for (name, b) in &reflective {
+            let (f1, f2) = (
+                b.eval(&BsdfQueryRecord::pair(wi, wo)),
+                b.eval(&BsdfQueryRecord::pair(wo, wi)),
+            );
+            assert!(
+                close3(f1, f2, 1e-3),
+                "{name}: f(wi,wo) {f1} vs f(wo,wi) {f2}"
+            );
+        }
+        for (name, b) in &glass {
+            let (f1, f2) = (
+                b.eval(&BsdfQueryRecord::pair(wi, wo)),
+                b.eval(&BsdfQueryRecord::pair(wo, wi)),
+            );
+            let scale = if wi.z * wo.z < 0.0 {
+                n_refr += (f1 != Vec3::ZERO) as usize;
+                // η_o / η_i, with wo on the side that wi.z's sign says.
+                let eta = if wi.z > 0.0 { b.ior } else { 1.0 / b.ior };
+                eta * eta
+            } else {
+                1.0
+            };
+            // Refraction recomputes the half vector from either end in f32: near the critical
+            // angle 1 - F is sensitive to it.
+            let tol = if scale == 1.0 { 1e-3 } else { 1e-2 };
+            assert!(
+                close3(f1, f2 * scale, tol) || (f1 - f2 * scale).abs().max_element() < 1e-5,
+                "{name}: f(wi,wo) {f1} vs η²·f(wo,wi) {} (wi {wi}, wo {wo})",
+                f2 * scale
+            );
+        }
+    }
+    assert!(n_refr > 1000, "too few refraction pairs: {n_refr}");
+}
+
+#[test]
+fn transparent_is_delta_pass_through() {
+    let b = Transparent::new(Vec3::new(0.2, 0.4, 0.6));
+    assert!(b.is_delta());
+    let mut rng = Sampler::new(500, 0, 0);
+    for k in 0..1000 {
+        let wi = incident(&mut rng, k);
+        let mut rec = BsdfQueryRecord::new(wi);
+        let w = b.sample(&mut rec, rng.next_2d(), rng.next_1d());
+        assert_eq!(
+            (w, rec.wo, rec.eta, rec.measure),
+            (b.color, -wi, 1.0, Measure::Discrete)
+        );
+        assert_eq!(b.pdf(&BsdfQueryRecord::pair(wi, -wi)), 0.0);
+        assert_eq!(b.eval(&BsdfQueryRecord::pair(wi, -wi)), Vec3::ZERO);
+    }
+}
+
 #[test]
 fn chosen_bsdf_instances_agree() {
     // The same checks through `choose` and the enum dispatch the integrators use.
@@ -142,6 +414,7 @@ fn chosen_bsdf_instances_agree() {
         (0.0, 0.7, 0.0, 0.0),
         (1.0, 0.3, 0.0, 1.0),
         (1.0, 0.9, 0.0, 1.0),
+        (0.0, 0.4, 1.0, 1.0),
     ] {
         let p = SurfaceParams {
             base_color: Vec3::new(0.8, 0.6, 0.4),
@@ -154,7 +427,12 @@ fn chosen_bsdf_instances_agree() {
         };
         let b = choose(&p, 0.5);
         seed += 1;
-        check_bsdf(&format!("{b:?}"), &b, seed);
+        if b.is_transmissive() {
+            assert!(matches!(b, BsdfInstance::RoughDielectric(_)), "{b:?}");
+            check_any_bsdf(&format!("{b:?}"), &b, seed, true);
+        } else {
+            check_bsdf(&format!("{b:?}"), &b, seed);
+        }
     }
 }
 

@@ -2,11 +2,13 @@
 //! (Heitz 2018), and a rough conductor built on it.
 //!
 //! Conventions: `alpha` = perceptual roughness²; half vectors live in the local frame (+Z up).
+//! Anisotropic variants (`*_aniso`) take `alpha_x` along local **+X, the tangent** and `alpha_y`
+//! along +Y (the bitangent); the caller builds the shading frame from its tangent.
 //! `D` is the normal distribution (per steradian of microfacet normals, projected area
 //! normalised: ∫ D(h) cos θh dh = 1); `G1`/`G2` are Smith's masking and height-correlated
 //! masking-shadowing functions.
 
-use super::{Bsdf, BsdfQueryRecord, Measure, fresnel};
+use super::{Bsdf, BsdfQueryRecord, Measure, fresnel, tables};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -90,19 +92,330 @@ pub fn sample_reflection(wi: Vec3, alpha: f32, u: Vec2) -> Option<(Vec3, f32)> {
     (pdf > 0.0 && pdf.is_finite()).then_some((wo, pdf))
 }
 
-/// A rough conductor: `f = F(wi·h) D(h) G2 / (4 cos θi cos θo)`, Schlick `F0` = base colour.
+/// Anisotropic GGX `D(h)`: `1 / (π αx αy (hx²/αx² + hy²/αy² + hz²)²)`.
+#[inline]
+pub fn ggx_d_aniso(h: Vec3, alpha_x: f32, alpha_y: f32) -> f32 {
+    if h.z <= 0.0 {
+        return 0.0;
+    }
+    let (x, y) = (h.x / alpha_x, h.y / alpha_y);
+    let l = x * x + y * y + h.z * h.z;
+    1.0 / (PI * alpha_x * alpha_y * l * l)
+}
+
+/// Anisotropic Smith `Λ(w)`: `(sqrt(1 + (αx² wx² + αy² wy²) / wz²) - 1) / 2`.
+#[inline]
+pub fn ggx_lambda_aniso(w: Vec3, alpha_x: f32, alpha_y: f32) -> f32 {
+    let c2 = w.z * w.z;
+    if c2 <= 0.0 {
+        return f32::INFINITY;
+    }
+    let (x, y) = (alpha_x * w.x, alpha_y * w.y);
+    0.5 * (-1.0 + (1.0 + (x * x + y * y) / c2).sqrt())
+}
+
+/// Anisotropic Smith masking `G1(w)`.
+#[inline]
+pub fn ggx_g1_aniso(w: Vec3, alpha_x: f32, alpha_y: f32) -> f32 {
+    1.0 / (1.0 + ggx_lambda_aniso(w, alpha_x, alpha_y))
+}
+
+/// Anisotropic height-correlated `G2(wi, wo)`.
+#[inline]
+pub fn ggx_g2_aniso(wi: Vec3, wo: Vec3, alpha_x: f32, alpha_y: f32) -> f32 {
+    1.0 / (1.0 + ggx_lambda_aniso(wi, alpha_x, alpha_y) + ggx_lambda_aniso(wo, alpha_x, alpha_y))
+}
+
+/// Visible-normal sampling for anisotropic GGX (Heitz 2018: stretch `wi`, sample the
+/// hemisphere's projected area, unstretch). Density `G1(wi) max(0, wi·h) D(h) / wi.z`.
+#[inline]
+pub fn sample_visible_normal_aniso(wi: Vec3, alpha_x: f32, alpha_y: f32, u: Vec2) -> Vec3 {
+    let vh = Vec3::new(alpha_x * wi.x, alpha_y * wi.y, wi.z).normalize();
+    let lensq = vh.x * vh.x + vh.y * vh.y;
+    let t1 = if lensq > 0.0 {
+        Vec3::new(-vh.y, vh.x, 0.0) / lensq.sqrt()
+    } else {
+        Vec3::X
+    };
+    let t2 = vh.cross(t1);
+    let r = u.x.sqrt();
+    let phi = 2.0 * PI * u.y;
+    let p1 = r * phi.cos();
+    let mut p2 = r * phi.sin();
+    let s = 0.5 * (1.0 + vh.z);
+    p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * p2;
+    let nh = t1 * p1 + t2 * p2 + vh * (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
+    Vec3::new(alpha_x * nh.x, alpha_y * nh.y, nh.z.max(1e-7)).normalize()
+}
+
+/// GGX roughness, isotropic or not, with the functions that dispatch on it. Isotropic lobes
+/// call exactly the isotropic functions above (bit-identical to code that uses them directly).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Roughness {
+    /// Along local +X (the tangent).
+    pub alpha_x: f32,
+    /// Along local +Y.
+    pub alpha_y: f32,
+}
+
+impl Roughness {
+    /// Alphas are clamped to `[DELTA_ALPHA, 1]` (Cycles' `bsdf_microfacet_ggx_setup` saturates
+    /// both, so e.g. the Glossy BSDF's `r² / (1 - a)` stops at 1); NaN becomes `DELTA_ALPHA`.
+    pub fn new(alpha_x: f32, alpha_y: f32) -> Self {
+        let fix = |a: f32| a.clamp(super::DELTA_ALPHA, 1.0);
+        let fix = |a: f32| {
+            if a.is_nan() {
+                super::DELTA_ALPHA
+            } else {
+                fix(a)
+            }
+        };
+        Roughness {
+            alpha_x: fix(alpha_x),
+            alpha_y: fix(alpha_y),
+        }
+    }
+
+    pub fn isotropic(alpha: f32) -> Self {
+        Roughness::new(alpha, alpha)
+    }
+
+    #[inline]
+    pub fn is_isotropic(&self) -> bool {
+        self.alpha_x == self.alpha_y
+    }
+
+    #[inline]
+    pub fn d(&self, h: Vec3) -> f32 {
+        if self.is_isotropic() {
+            ggx_d(h, self.alpha_x)
+        } else {
+            ggx_d_aniso(h, self.alpha_x, self.alpha_y)
+        }
+    }
+
+    #[inline]
+    pub fn g1(&self, w: Vec3) -> f32 {
+        if self.is_isotropic() {
+            ggx_g1(w, self.alpha_x)
+        } else {
+            ggx_g1_aniso(w, self.alpha_x, self.alpha_y)
+        }
+    }
+
+    #[inline]
+    pub fn g2(&self, wi: Vec3, wo: Vec3) -> f32 {
+        if self.is_isotropic() {
+            ggx_g2(wi, wo, self.alpha_x)
+        } else {
+            ggx_g2_aniso(wi, wo, self.alpha_x, self.alpha_y)
+        }
+    }
+
+    /// A visible normal for `wi` (`wi.z > 0`).
+    #[inline]
+    pub fn sample_visible_normal(&self, wi: Vec3, u: Vec2) -> Vec3 {
+        if self.is_isotropic() {
+            sample_visible_normal(wi, self.alpha_x, u)
+        } else {
+            sample_visible_normal_aniso(wi, self.alpha_x, self.alpha_y, u)
+        }
+    }
+
+    /// Density of the visible normal `h`: `G1(wi) max(0, wi·h) D(h) / wi.z`.
+    #[inline]
+    pub fn visible_normal_pdf(&self, wi: Vec3, h: Vec3) -> f32 {
+        if wi.z <= 0.0 {
+            return 0.0;
+        }
+        self.g1(wi) * wi.dot(h).max(0.0) * self.d(h) / wi.z
+    }
+
+    /// Solid-angle density of the reflected `wo`: `G1(wi) D(h) / (4 wi.z)`.
+    #[inline]
+    pub fn reflection_pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
+        if self.is_isotropic() {
+            return reflection_pdf(wi, wo, self.alpha_x);
+        }
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return 0.0;
+        }
+        let h = (wi + wo).normalize();
+        self.g1(wi) * self.d(h) / (4.0 * wi.z)
+    }
+
+    /// A reflected direction `(wo, pdf)`, or `None` below the horizon.
+    #[inline]
+    pub fn sample_reflection(&self, wi: Vec3, u: Vec2) -> Option<(Vec3, f32)> {
+        if self.is_isotropic() {
+            return sample_reflection(wi, self.alpha_x, u);
+        }
+        let h = self.sample_visible_normal(wi, u);
+        let wo = 2.0 * wi.dot(h) * h - wi;
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let pdf = self.reflection_pdf(wi, wo);
+        (pdf > 0.0 && pdf.is_finite()).then_some((wo, pdf))
+    }
+}
+
+/// Cycles' anisotropy mappings from a roughness `r` (alpha = r²) and an anisotropy `a`
+/// to `(alpha_x, alpha_y)`, alpha_x along the tangent.
+pub mod anisotropy {
+    /// Principled BSDF and the Metallic BSDF (`svm/closure.h`): `a` in `[0, 1]`,
+    /// `aspect = sqrt(1 - 0.9 a)`, `alpha_x = r² / aspect`, `alpha_y = r² · aspect`.
+    pub fn principled(roughness: f32, anisotropic: f32) -> (f32, f32) {
+        let r = roughness.clamp(0.0, 1.0);
+        let alpha = r * r;
+        let a = anisotropic.clamp(0.0, 1.0);
+        if a <= 0.0 {
+            return (alpha, alpha);
+        }
+        let aspect = (1.0 - 0.9 * a).sqrt();
+        (alpha / aspect, alpha * aspect)
+    }
+
+    /// Glossy BSDF (`svm/closure.h`): `a` clamped to `[-0.99, 0.99]`; for `a < 0`
+    /// `(r²/(1+a), r²(1+a))`, else `(r²(1-a), r²/(1-a))`; isotropic for `|a| ≤ 1e-4`.
+    pub fn glossy(roughness: f32, anisotropy: f32) -> (f32, f32) {
+        let r = roughness.clamp(0.0, 1.0);
+        let alpha = r * r;
+        let a = anisotropy.clamp(-0.99, 0.99);
+        if a.abs() <= 1e-4 {
+            (alpha, alpha)
+        } else if a < 0.0 {
+            (alpha / (1.0 + a), alpha * (1.0 + a))
+        } else {
+            (alpha * (1.0 - a), alpha / (1.0 - a))
+        }
+    }
+}
+
+/// The reflectance model of a [`RoughConductor`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ConductorFresnel {
+    /// Schlick with `F0` (glTF metals).
+    Schlick(Vec3),
+    /// A constant colour, no Fresnel: Blender's Glossy BSDF (Cycles' GGX glossy closure has
+    /// `fresnel_type = NONE` and the colour as the closure weight).
+    Constant(Vec3),
+    /// Cycles' F82-tint (Principled metallic and the Metallic BSDF's "F82" mode):
+    /// `F = Schlick(F0) - b cos (1 - cos)^6`, clamped to `[0, 1]`.
+    F82 { f0: Vec3, b: Vec3 },
+}
+
+impl ConductorFresnel {
+    /// F82-tint from the base colour (`F0`) and the edge tint (Principled: Specular Tint;
+    /// Metallic BSDF: Edge Tint), both clamped to `[0, 1]` as Cycles does. With a white tint
+    /// this is exactly Schlick.
+    pub fn f82_tint(f0: Vec3, tint: Vec3) -> Self {
+        let f0 = f0.clamp(Vec3::ZERO, Vec3::ONE);
+        let tint = tint.clamp(Vec3::ZERO, Vec3::ONE);
+        let b = if tint == Vec3::ONE {
+            Vec3::ZERO
+        } else {
+            // Solve F82Tint(1/7) = Schlick(1/7) · tint for b (Cycles' fresnel_f82tint_B).
+            let f: f32 = 6.0 / 7.0;
+            let f5 = f.powi(5);
+            let schlick = f0 + (Vec3::ONE - f0) * f5;
+            schlick * (7.0 / (f5 * f)) * (Vec3::ONE - tint)
+        };
+        ConductorFresnel::F82 { f0, b }
+    }
+
+    /// The average single-scattering reflectance `F_ss` Cycles uses for the multiple-bounce
+    /// Fresnel: `mix(F0, 1, 1/21) - b/126` (exact for Schlick/F82), or the constant colour.
+    pub fn fss(&self) -> Vec3 {
+        match *self {
+            ConductorFresnel::Schlick(f0) => f0 + (Vec3::ONE - f0) / 21.0,
+            ConductorFresnel::Constant(c) => c,
+            ConductorFresnel::F82 { f0, b } => f0 + (Vec3::ONE - f0) / 21.0 - b / 126.0,
+        }
+    }
+
+    /// The reflectance at `cos = wi·h`.
+    #[inline]
+    pub fn eval(&self, cos: f32) -> Vec3 {
+        match *self {
+            ConductorFresnel::Schlick(f0) => fresnel::schlick(f0, cos),
+            ConductorFresnel::Constant(c) => c,
+            ConductorFresnel::F82 { f0, b } => {
+                let s = (1.0 - cos).clamp(0.0, 1.0);
+                let s5 = s * s * s * s * s;
+                let schlick = f0 + (Vec3::ONE - f0) * s5;
+                (schlick - b * (cos * s5 * s)).clamp(Vec3::ZERO, Vec3::ONE)
+            }
+        }
+    }
+}
+
+/// A rough conductor: `f = F(wi·h) D(h) G2 / (4 cos θi cos θo)` with GGX, isotropic or
+/// anisotropic (alpha_x along local +X, the tangent), and the reflectance of
+/// [`ConductorFresnel`]. Reflects on the +Z side only.
+///
+/// With `multiscatter` (Cycles' "Multiscatter GGX", the Principled default), `f` is scaled by
+/// [`tables::multiscatter_factor`]`(E(μ), E_avg, F_ss)`, Cycles' energy compensation of the
+/// single-scattering loss (the sampled directions and the pdf are unchanged).
 #[derive(Clone, Copy, Debug)]
 pub struct RoughConductor {
-    pub f0: Vec3,
-    pub alpha: f32,
+    pub roughness: Roughness,
+    pub fresnel: ConductorFresnel,
+    pub multiscatter: bool,
 }
 
 impl RoughConductor {
+    /// Isotropic GGX with Schlick `F0` (glTF's metal).
     pub fn new(f0: Vec3, alpha: f32) -> Self {
         RoughConductor {
-            f0,
-            alpha: alpha.max(super::DELTA_ALPHA),
+            roughness: Roughness::isotropic(alpha),
+            fresnel: ConductorFresnel::Schlick(f0),
+            multiscatter: false,
         }
+    }
+
+    /// Any roughness and reflectance model; alphas below [`super::DELTA_ALPHA`] are raised to it.
+    pub fn with(alpha_x: f32, alpha_y: f32, fresnel: ConductorFresnel) -> Self {
+        RoughConductor {
+            roughness: Roughness::new(alpha_x, alpha_y),
+            fresnel,
+            multiscatter: false,
+        }
+    }
+
+    /// The same lobe with Cycles' Multiscatter GGX energy compensation.
+    pub fn multiscatter(self) -> Self {
+        RoughConductor {
+            multiscatter: true,
+            ..self
+        }
+    }
+
+    /// The energy-compensation factor for this `wi` (1 without `multiscatter`).
+    #[inline]
+    pub fn energy_factor(&self, wi: Vec3) -> Vec3 {
+        if !self.multiscatter {
+            return Vec3::ONE;
+        }
+        let (e, e_avg) = tables::ggx_e(self.roughness.alpha_x, self.roughness.alpha_y, wi.z);
+        tables::multiscatter_factor(e, e_avg, self.fresnel.fss())
+    }
+
+    /// Blender's Glossy BSDF (distribution GGX): `color` = Color input, `(alpha_x, alpha_y)`
+    /// from [`anisotropy::glossy`]`(Roughness, Anisotropy)`.
+    pub fn glossy(color: Vec3, alpha_x: f32, alpha_y: f32) -> Self {
+        RoughConductor::with(alpha_x, alpha_y, ConductorFresnel::Constant(color))
+    }
+
+    /// Principled BSDF's metallic lobe (Cycles 4.x/5.x): F82-tint with `F0` = Base Color and
+    /// the edge tint = Specular Tint; `(alpha_x, alpha_y)` from
+    /// [`anisotropy::principled`]`(Roughness, Anisotropic)`.
+    pub fn f82(base_color: Vec3, specular_tint: Vec3, alpha_x: f32, alpha_y: f32) -> Self {
+        RoughConductor::with(
+            alpha_x,
+            alpha_y,
+            ConductorFresnel::f82_tint(base_color, specular_tint),
+        )
     }
 }
 
@@ -111,7 +424,7 @@ impl Bsdf for RoughConductor {
         if rec.wi.z <= 0.0 {
             return Vec3::ZERO;
         }
-        let Some((wo, pdf)) = sample_reflection(rec.wi, self.alpha, u) else {
+        let Some((wo, pdf)) = self.roughness.sample_reflection(rec.wi, u) else {
             return Vec3::ZERO;
         };
         rec.wo = wo;
@@ -120,8 +433,13 @@ impl Bsdf for RoughConductor {
         rec.measure = Measure::SolidAngle;
         let h = (rec.wi + wo).normalize();
         // f cos / pdf = F G2 / G1(wi)
-        fresnel::schlick(self.f0, rec.wi.dot(h)) * ggx_g2(rec.wi, wo, self.alpha)
-            / ggx_g1(rec.wi, self.alpha)
+        let w = self.fresnel.eval(rec.wi.dot(h)) * self.roughness.g2(rec.wi, wo)
+            / self.roughness.g1(rec.wi);
+        if self.multiscatter {
+            w * self.energy_factor(rec.wi)
+        } else {
+            w
+        }
     }
 
     fn eval(&self, rec: &BsdfQueryRecord) -> Vec3 {
@@ -130,12 +448,17 @@ impl Bsdf for RoughConductor {
             return Vec3::ZERO;
         }
         let h = (wi + wo).normalize();
-        fresnel::schlick(self.f0, wi.dot(h)) * ggx_d(h, self.alpha) * ggx_g2(wi, wo, self.alpha)
-            / (4.0 * wi.z * wo.z)
+        let f = self.fresnel.eval(wi.dot(h)) * self.roughness.d(h) * self.roughness.g2(wi, wo)
+            / (4.0 * wi.z * wo.z);
+        if self.multiscatter {
+            f * self.energy_factor(wi)
+        } else {
+            f
+        }
     }
 
     fn pdf(&self, rec: &BsdfQueryRecord) -> f32 {
-        reflection_pdf(rec.wi, rec.wo, self.alpha)
+        self.roughness.reflection_pdf(rec.wi, rec.wo)
     }
 
     fn is_delta(&self) -> bool {

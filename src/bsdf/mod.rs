@@ -10,18 +10,29 @@ pub mod closure;
 pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
+pub mod layered;
 pub mod microfacet;
 pub mod mirror;
 pub mod plastic;
+pub mod rough_dielectric;
+pub mod sheen;
+pub mod tables;
+pub mod translucent;
+pub mod transparent;
 
 use glam::{Vec2, Vec3};
 
 pub use closure::from_closure;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
-pub use microfacet::RoughConductor;
+pub use layered::{BaseLobe, Coat, Layer, Layered, TopLobe};
+pub use microfacet::{ConductorFresnel, RoughConductor, Roughness};
 pub use mirror::Mirror;
 pub use plastic::Plastic;
+pub use rough_dielectric::{DielectricMode, RoughDielectric, principled_specular_ior};
+pub use sheen::Sheen;
+pub use translucent::Translucent;
+pub use transparent::Transparent;
 
 /// Which measure a sampled direction's density is expressed in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -83,6 +94,10 @@ pub trait Bsdf {
 }
 
 /// The BSDF chosen at one surface hit: a closed set of variants, built on the stack.
+///
+/// Lobes that live in a tangent frame (anisotropic [`RoughConductor`], [`RoughDielectric`]
+/// with `alpha_x != alpha_y`) take local +X as the tangent: the caller builds the shading frame
+/// from the (rotated) tangent for them.
 #[derive(Clone, Copy, Debug)]
 pub enum BsdfInstance {
     Diffuse(Diffuse),
@@ -90,6 +105,12 @@ pub enum BsdfInstance {
     Dielectric(Dielectric),
     RoughConductor(RoughConductor),
     Plastic(Plastic),
+    RoughDielectric(RoughDielectric),
+    Translucent(Translucent),
+    Transparent(Transparent),
+    Sheen(Sheen),
+    /// A coat or sheen over a base lobe ([`layered`]).
+    Layered(Layered<TopLobe, BaseLobe>),
 }
 
 macro_rules! dispatch {
@@ -100,6 +121,11 @@ macro_rules! dispatch {
             BsdfInstance::Dielectric($b) => $e,
             BsdfInstance::RoughConductor($b) => $e,
             BsdfInstance::Plastic($b) => $e,
+            BsdfInstance::RoughDielectric($b) => $e,
+            BsdfInstance::Translucent($b) => $e,
+            BsdfInstance::Transparent($b) => $e,
+            BsdfInstance::Sheen($b) => $e,
+            BsdfInstance::Layered($b) => $e,
         }
     };
 }
@@ -126,7 +152,14 @@ impl Bsdf for BsdfInstance {
 impl BsdfInstance {
     /// True for BSDFs that transmit (the shading frame must not be flipped towards `wi`).
     pub fn is_transmissive(&self) -> bool {
-        matches!(self, BsdfInstance::Dielectric(_))
+        match self {
+            BsdfInstance::Dielectric(_)
+            | BsdfInstance::Translucent(_)
+            | BsdfInstance::Transparent(_) => true,
+            BsdfInstance::RoughDielectric(d) => d.mode != DielectricMode::Reflection,
+            BsdfInstance::Layered(l) => l.base.is_transmissive(),
+            _ => false,
+        }
     }
 }
 
@@ -149,7 +182,8 @@ pub struct SurfaceParams {
 /// mixture weight (transmission, then metal, then the dielectric base), so that the chosen
 /// BSDF's weight estimates the whole mixture without bias. `u` is uniform in `[0,1)`.
 ///
-/// - transmission → [`Dielectric`] (ideal; roughness is ignored for transmission),
+/// - transmission → [`Dielectric`] (alpha below [`DELTA_ALPHA`]) or [`RoughDielectric`]
+///   (GGX, Cycles' Principled transmission: `sqrt(base colour)` per refraction),
 /// - metal → [`Mirror`] (alpha below [`DELTA_ALPHA`]) or [`RoughConductor`] (GGX),
 /// - dielectric base → [`Plastic`] (GGX or smooth coat over Lambert) or [`Diffuse`] when
 ///   `specular · max(specular colour)` is 0 (Blender's Specular IOR Level 0: 4.x writes
@@ -159,7 +193,16 @@ pub fn choose(p: &SurfaceParams, u: f32) -> BsdfInstance {
     let transmission = p.transmission.clamp(0.0, 1.0) * (1.0 - p.metallic.clamp(0.0, 1.0));
     let metallic = p.metallic.clamp(0.0, 1.0);
     if u < transmission {
-        return BsdfInstance::Dielectric(Dielectric::new(p.ior, p.base_color));
+        return if alpha < DELTA_ALPHA {
+            BsdfInstance::Dielectric(Dielectric::new(p.ior, p.base_color))
+        } else {
+            BsdfInstance::RoughDielectric(RoughDielectric::principled_transmission(
+                p.base_color,
+                Vec3::ONE,
+                p.ior,
+                alpha,
+            ))
+        };
     }
     let u = if transmission > 0.0 {
         (u - transmission) / (1.0 - transmission)
