@@ -1,17 +1,21 @@
 //! From a shading closure to the BSDF that renders it.
 
+use super::microfacet::anisotropy;
+use super::sheen::Sheen;
 use super::{
-    BsdfInstance, DELTA_ALPHA, Dielectric, Diffuse, Mirror, RoughConductor, SurfaceParams, choose,
+    BaseLobe, BsdfInstance, Coat, DELTA_ALPHA, Dielectric, Diffuse, Layered, Mirror, Plastic,
+    RoughConductor, RoughDielectric, SurfaceParams, TopLobe, Translucent, Transparent, choose,
 };
-use crate::shading::{Closure, ClosureKind};
+use crate::shading::{Closure, ClosureKind, Principled};
 use glam::Vec3;
 
 /// The BSDF of closure `c` (its weight is applied by the caller); `u` in `[0, 1)` chooses
-/// between the lobes of a layered closure such as the Principled BSDF.
+/// between the lobes of a layered closure such as the Principled BSDF. Anisotropic lobes
+/// take local +X as their tangent: the caller builds the frame from [`Closure::tangent`].
 #[inline]
 pub fn from_closure(c: &Closure, u: f32) -> BsdfInstance {
-    match c.kind {
-        ClosureKind::Principled(p) => choose(
+    match &c.kind {
+        ClosureKind::Principled(p) if !p.cycles => choose(
             &SurfaceParams {
                 base_color: p.base_color,
                 metallic: p.metallic,
@@ -23,30 +27,137 @@ pub fn from_closure(c: &Closure, u: f32) -> BsdfInstance {
             },
             u,
         ),
-        ClosureKind::Diffuse { color } => BsdfInstance::Diffuse(Diffuse::new(color)),
+        ClosureKind::Principled(p) => principled(p, u),
+        ClosureKind::Diffuse { color } => BsdfInstance::Diffuse(Diffuse::new(*color)),
         ClosureKind::Glossy {
-            color, roughness, ..
+            color,
+            roughness,
+            anisotropy: a,
+            multiscatter,
+            ..
         } => {
-            let alpha = (roughness * roughness).clamp(0.0, 1.0);
-            // Blender's Glossy BSDF has no Fresnel: a conductor whose F0 is white reflects
-            // the same at every angle; the colour is in the closure's weight.
-            if alpha < DELTA_ALPHA {
-                BsdfInstance::Mirror(Mirror::new(color))
+            let (ax, ay) = anisotropy::glossy(*roughness, *a);
+            // Blender's Glossy BSDF has no Fresnel; its colour is in the closure's weight.
+            if ax.max(ay) < DELTA_ALPHA {
+                BsdfInstance::Mirror(Mirror::new(*color))
             } else {
-                BsdfInstance::RoughConductor(RoughConductor::new(color, alpha))
+                let l = RoughConductor::glossy(*color, ax, ay);
+                BsdfInstance::RoughConductor(if *multiscatter { l.multiscatter() } else { l })
             }
         }
-        ClosureKind::Glass { color, ior, .. } | ClosureKind::Refraction { color, ior, .. } => {
-            // Glass tints every path through it by its colour once (the weight); the
-            // dielectric's own per-refraction tint stays white.
+        ClosureKind::Glass {
+            color,
+            roughness,
+            ior,
+            multiscatter,
+        } => {
+            let alpha = roughness * roughness;
+            if alpha < DELTA_ALPHA {
+                // The colour tints every path through the glass once (the closure weight).
+                let _ = color;
+                BsdfInstance::Dielectric(Dielectric::new(*ior, Vec3::ONE))
+            } else {
+                let l = RoughDielectric::glass(Vec3::ONE, *ior, alpha);
+                BsdfInstance::RoughDielectric(if *multiscatter { l.multiscatter() } else { l })
+            }
+        }
+        ClosureKind::Refraction {
+            color,
+            roughness,
+            ior,
+        } => {
             let _ = color;
-            BsdfInstance::Dielectric(Dielectric::new(ior, Vec3::ONE))
+            let alpha = (roughness * roughness).max(DELTA_ALPHA);
+            BsdfInstance::RoughDielectric(RoughDielectric::refraction(Vec3::ONE, *ior, alpha))
         }
-        // Until dedicated lobes exist: Lambertian reflection for translucency, and an
-        // index-matched dielectric (which refracts straight through) for transparency.
-        ClosureKind::Translucent { color } => BsdfInstance::Diffuse(Diffuse::new(color)),
-        ClosureKind::Transparent { color } => {
-            BsdfInstance::Dielectric(Dielectric::new(1.0, color * color))
+        ClosureKind::Translucent { color } => BsdfInstance::Translucent(Translucent::new(*color)),
+        ClosureKind::Transparent { color } => BsdfInstance::Transparent(Transparent::new(*color)),
+    }
+}
+
+/// Blender's Principled BSDF (4.x/5.x): one of transmission, metal or the dielectric base is
+/// chosen with probability equal to its mixture weight; coat and sheen are layered on top.
+fn principled(p: &Principled, u: f32) -> BsdfInstance {
+    let r = p.roughness.clamp(0.0, 1.0);
+    let alpha = r * r;
+    let (ax, ay) = anisotropy::principled(r, p.anisotropic);
+    let metallic = p.metallic.clamp(0.0, 1.0);
+    let transmission = p.transmission.clamp(0.0, 1.0) * (1.0 - metallic);
+    let base = if u < transmission {
+        if alpha < DELTA_ALPHA {
+            BaseLobe::Dielectric(Dielectric::new(p.ior, p.base_color))
+        } else {
+            BaseLobe::RoughDielectric(
+                RoughDielectric::principled_transmission(
+                    p.base_color,
+                    p.specular_tint,
+                    p.ior,
+                    alpha,
+                )
+                .multiscatter(),
+            )
         }
+    } else {
+        let u2 = if transmission > 0.0 {
+            (u - transmission) / (1.0 - transmission)
+        } else {
+            u
+        };
+        if u2 < metallic {
+            if ax.max(ay) < DELTA_ALPHA {
+                BaseLobe::Mirror(Mirror::new(p.base_color))
+            } else {
+                BaseLobe::RoughConductor(
+                    RoughConductor::f82(p.base_color, p.specular_tint, ax, ay).multiscatter(),
+                )
+            }
+        } else if p.specular_level * p.specular_tint.max_element() <= 0.0 {
+            BaseLobe::Diffuse(Diffuse::new(p.base_color))
+        } else {
+            BaseLobe::Plastic(Plastic::new(
+                p.base_color,
+                alpha,
+                p.ior,
+                2.0 * p.specular_level,
+                p.specular_tint,
+            ))
+        }
+    };
+    let coat = (p.coat_weight > 0.0)
+        .then(|| Coat::new(p.coat_weight, p.coat_roughness, p.coat_ior, p.coat_tint));
+    let sheen = (p.sheen_weight > 0.0 && p.sheen_tint.max_element() > 0.0)
+        .then(|| Sheen::new(p.sheen_tint * p.sheen_weight, p.sheen_roughness));
+    match (coat, sheen) {
+        (None, None) => unlayered(base),
+        (Some(c), None) => BsdfInstance::Layered(Layered::new(TopLobe::Coat(c), base)),
+        (None, Some(s)) => BsdfInstance::Layered(Layered::new(TopLobe::Sheen(s), base)),
+        (Some(c), Some(s)) => {
+            // Sheen over coat over the base, where the enum can hold it; else the coat.
+            let inner = match base {
+                BaseLobe::Diffuse(d) => Some(BaseLobe::CoatedDiffuse(Layered::new(c, d))),
+                BaseLobe::RoughConductor(m) => Some(BaseLobe::CoatedConductor(Layered::new(c, m))),
+                _ => None,
+            };
+            match inner {
+                Some(b) => BsdfInstance::Layered(Layered::new(TopLobe::Sheen(s), b)),
+                None => BsdfInstance::Layered(Layered::new(TopLobe::Coat(c), base)),
+            }
+        }
+    }
+}
+
+fn unlayered(b: BaseLobe) -> BsdfInstance {
+    match b {
+        BaseLobe::Diffuse(x) => BsdfInstance::Diffuse(x),
+        BaseLobe::Mirror(x) => BsdfInstance::Mirror(x),
+        BaseLobe::Dielectric(x) => BsdfInstance::Dielectric(x),
+        BaseLobe::RoughConductor(x) => BsdfInstance::RoughConductor(x),
+        BaseLobe::Plastic(x) => BsdfInstance::Plastic(x),
+        BaseLobe::RoughDielectric(x) => BsdfInstance::RoughDielectric(x),
+        BaseLobe::Translucent(x) => BsdfInstance::Translucent(x),
+        other => BsdfInstance::Layered(Layered::new(
+            TopLobe::Sheen(Sheen::new(Vec3::ZERO, 0.5)),
+            other,
+        )),
     }
 }

@@ -92,7 +92,22 @@ impl ShadingPoint {
         } else if n.dot(-d) < 0.0 {
             n = -n;
         }
-        let frame = Frame::from_normal(n);
+        let frame = match anisotropic_rotation(&closure.kind) {
+            Some(rotation) => {
+                let t = if closure.tangent == Vec3::ZERO {
+                    scene
+                        .globals(its, d, depth, 0)
+                        .tangent()
+                        .map_or(Vec3::ZERO, |(t, _)| {
+                            crate::shading::globals::from_blender(t)
+                        })
+                } else {
+                    closure.tangent
+                };
+                tangent_frame(n, t, rotation)
+            }
+            None => Frame::from_normal(n),
+        };
         Some(ShadingPoint {
             passes: matches!(
                 closure.kind,
@@ -170,6 +185,41 @@ impl ShadingPoint {
             return None;
         }
         Some((wo, w, rec))
+    }
+}
+
+/// The rotation (in turns) of an anisotropic closure's tangent, `None` for isotropic ones.
+#[inline]
+fn anisotropic_rotation(k: &crate::shading::ClosureKind) -> Option<f32> {
+    use crate::shading::ClosureKind;
+    match k {
+        ClosureKind::Glossy {
+            anisotropy,
+            rotation,
+            ..
+        } if *anisotropy != 0.0 => Some(*rotation),
+        ClosureKind::Principled(p) if p.cycles && p.anisotropic != 0.0 => {
+            Some(p.anisotropic_rotation)
+        }
+        _ => None,
+    }
+}
+
+/// A frame around unit normal `n` whose local +X is the tangent `t` (projected into the
+/// tangent plane) turned by `rotation` turns about `n`, as Blender's anisotropic lobes want.
+fn tangent_frame(n: Vec3, t: Vec3, rotation: f32) -> Frame {
+    let t = t - n * n.dot(t);
+    if t.length_squared() < 1e-20 || !t.is_finite() {
+        return Frame::from_normal(n);
+    }
+    let t = t.normalize();
+    let b = n.cross(t);
+    let (sin, cos) = (rotation * std::f32::consts::TAU).sin_cos();
+    let s = t * cos + b * sin;
+    Frame {
+        s,
+        t: n.cross(s),
+        n,
     }
 }
 

@@ -32,6 +32,9 @@ pub struct Principled {
     pub subsurface_weight: f32,
     pub subsurface_radius: Vec3,
     pub subsurface_scale: f32,
+    /// Blender's Principled (F82 metals, multiple-scattering GGX, coat and sheen layers);
+    /// false for glTF materials, which keep their Schlick metal and single-scattering GGX.
+    pub cycles: bool,
 }
 
 /// One BSDF closure's kind and parameters.
@@ -48,12 +51,15 @@ pub enum ClosureKind {
         roughness: f32,
         anisotropy: f32,
         rotation: f32,
+        /// Multiple-scattering GGX (energy compensation), Blender's default distribution.
+        multiscatter: bool,
     },
     /// Dielectric reflection and refraction (Blender's Glass BSDF).
     Glass {
         color: Vec3,
         roughness: f32,
         ior: f32,
+        multiscatter: bool,
     },
     /// Dielectric refraction only (Blender's Refraction BSDF).
     Refraction {

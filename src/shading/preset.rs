@@ -38,6 +38,7 @@ pub fn metallic_roughness(m: &Material, textures: &[Texture]) -> Graph {
         )
     };
     let mut principled = Node::new("ShaderNodeBsdfPrincipled")
+        .prop("gltf", json!(true))
         .with("Metallic", &[m.metallic])
         .with("Roughness", &[m.roughness])
         .with("IOR", &[m.ior])

@@ -53,6 +53,7 @@ pub struct PrincipledSlots {
     subsurface_scale: Slot,
     emission_color: Slot,
     emission_strength: Slot,
+    cycles: bool,
 }
 
 /// A closure node's inputs.
@@ -70,6 +71,7 @@ pub enum ClosureParams {
         rotation: Slot,
         normal: Option<Slot>,
         tangent: Option<Slot>,
+        multiscatter: bool,
     },
     Glass {
         color: Slot,
@@ -77,6 +79,7 @@ pub enum ClosureParams {
         ior: Slot,
         normal: Option<Slot>,
         refraction_only: bool,
+        multiscatter: bool,
     },
     Translucent {
         color: Slot,
@@ -189,6 +192,7 @@ impl ClosureOp {
                     subsurface_weight: s.f(p.subsurface_weight).clamp(0.0, 1.0),
                     subsurface_radius: col(p.subsurface_radius),
                     subsurface_scale: s.f(p.subsurface_scale).max(0.0),
+                    cycles: p.cycles,
                 };
                 push(
                     out,
@@ -215,6 +219,7 @@ impl ClosureOp {
                 rotation,
                 normal: n,
                 tangent: t,
+                multiscatter,
             } => push(
                 out,
                 col(*color) * w,
@@ -225,6 +230,7 @@ impl ClosureOp {
                     roughness: s.f(*roughness).clamp(0.0, 1.0),
                     anisotropy: s.f(*anisotropy).clamp(-1.0, 1.0),
                     rotation: s.f(*rotation),
+                    multiscatter: *multiscatter,
                 },
             ),
             ClosureParams::Glass {
@@ -233,6 +239,7 @@ impl ClosureOp {
                 ior,
                 normal: n,
                 refraction_only,
+                multiscatter,
             } => {
                 let (color, roughness, ior) = (
                     col(*color),
@@ -250,6 +257,7 @@ impl ClosureOp {
                         color,
                         roughness,
                         ior,
+                        multiscatter: *multiscatter,
                     }
                 };
                 push(out, Vec3::splat(w), normal(*n), Vec3::ZERO, kind);
@@ -348,6 +356,7 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                 subsurface_scale: f(cx, "Subsurface Scale", 0.05)?,
                 emission_color: c(cx, "Emission Color", Vec3::ONE)?,
                 emission_strength: f(cx, "Emission Strength", 0.0)?,
+                cycles: !cx.prop_bool("gltf", false),
             };
             if cx.is_linked("Alpha") || cx.const_value("Alpha").is_some_and(|v| v[0] < 1.0) {
                 cx.passes();
@@ -364,9 +373,6 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                     "Subsurface Weight",
                     "subsurface scattering renders as diffuse",
                 ),
-                ("Sheen Weight", "sheen is not rendered yet"),
-                ("Coat Weight", "the coat layer is not rendered yet"),
-                ("Anisotropic", "anisotropy is not rendered yet"),
                 ("Thin Film Thickness", "thin film is not rendered"),
             ] {
                 if cx.is_linked(id) || cx.const_value(id).is_some_and(|v| v[0] != 0.0) {
@@ -386,6 +392,7 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
             rotation: cx.float("Rotation", 0.0)?,
             normal: normal(cx, "Normal")?,
             tangent: normal(cx, "Tangent")?,
+            multiscatter: cx.prop_str("distribution").unwrap_or("MULTI_GGX") == "MULTI_GGX",
         },
         "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction" => ClosureParams::Glass {
             color: cx.color("Color", Vec3::ONE)?,
@@ -393,6 +400,7 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
             ior: cx.float("IOR", 1.5)?,
             normal: normal(cx, "Normal")?,
             refraction_only: kind == "ShaderNodeBsdfRefraction",
+            multiscatter: cx.prop_str("distribution").unwrap_or("MULTI_GGX") == "MULTI_GGX",
         },
         "ShaderNodeBsdfTranslucent" => ClosureParams::Translucent {
             color: cx.color("Color", Vec3::splat(0.8))?,
