@@ -253,7 +253,32 @@ def light_normalized(light):
     return bool(getattr(light, "normalize", True))
 
 
+def light_soft_falloff(light):
+    """Point/spot 'Soft Falloff' (4.0+, on by default): Cycles then renders the radius as a disk
+    facing the lit point; off, as a sphere. Before 4.0 Cycles always used the disk."""
+    return bool(getattr(light, "use_soft_falloff", True))
+
+
+def light_uses_mis(light):
+    """Cycles' per-light 'Multiple Importance' setting (on by default)."""
+    cyc = getattr(light, "cycles", None)
+    return bool(getattr(cyc, "use_multiple_importance_sampling", True)) if cyc is not None else True
+
+
 # --- object visibility ---------------------------------------------------------
+
+def ray_visibility(obj):
+    """The object's ray visibility, Object > Visibility > Ray Visibility:
+    {"camera", "diffuse", "glossy", "transmission"} (3.0+ `visible_*`, before `cycles_visibility`)."""
+    out = {}
+    cv = getattr(obj, "cycles_visibility", None)
+    for key in ("camera", "diffuse", "glossy", "transmission"):
+        v = getattr(obj, "visible_" + key, None)
+        if v is None:
+            v = getattr(cv, key, True) if cv is not None else True
+        out[key] = bool(v)
+    return out
+
 
 def visible_camera(obj):
     v = getattr(obj, "visible_camera", None)

@@ -37,6 +37,7 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
+#[allow(clippy::large_enum_variant)] // parsed once
 enum Command {
     /// Render a scene to an image (or to the Blender add-on with --pipe).
     Render(RenderArgs),
@@ -88,9 +89,10 @@ struct RenderArgs {
     /// Worker threads (0 = one per core).
     #[arg(long, default_value_t = 0)]
     threads: usize,
-    /// How a light is chosen for each shadow ray: power (proportional to emitted power) or
-    /// uniform (the seed's choice).
-    #[arg(long, default_value = "power", value_parser = ["power", "uniform"])]
+    /// How a light is chosen for each shadow ray: power (proportional to emitted power; with 8
+    /// or more lights at finite positions through a light tree that also weighs their distance
+    /// and orientation), flat (proportional to power, no tree) or uniform (the seed's choice).
+    #[arg(long, default_value = "power", value_parser = ["power", "flat", "uniform"])]
     light_choice: String,
     /// Render only the window X Y W H of the full frame (pixels, top-left origin).
     #[arg(long, num_args = 4, value_names = ["X", "Y", "W", "H"])]
@@ -105,6 +107,21 @@ struct RenderArgs {
     /// No progress bar or summary.
     #[arg(short, long)]
     quiet: bool,
+    /// Light the scene with an equirectangular environment image (.exr or .hdr), replacing
+    /// its world. Oriented as Cycles orients it in Blender's Z-up world: the image's centre
+    /// column looks along +X, its left quarter along +Y, its top row straight up.
+    #[arg(long, value_name = "FILE", conflicts_with = "background")]
+    env: Option<PathBuf>,
+    /// Multiplies the environment's radiance (the Background node's strength). Default 1.
+    #[arg(long, value_name = "S", requires = "env", allow_hyphen_values = true)]
+    env_strength: Option<f32>,
+    /// Turns the environment about the vertical axis by DEG degrees (the Z rotation of a
+    /// Mapping node between Texture Coordinate and the Environment Texture, as in Blender).
+    #[arg(long, value_name = "DEG", requires = "env", allow_hyphen_values = true)]
+    env_rotation: Option<f32>,
+    /// A constant world of linear RGB radiance R G B, replacing the scene's world.
+    #[arg(long, num_args = 3, value_names = ["R", "G", "B"])]
+    background: Option<Vec<f32>>,
 }
 
 extern "C" fn on_signal(_: libc::c_int) {
@@ -132,7 +149,75 @@ fn spawn_cancel_watchdog() {
     });
 }
 
+/// Exit status: bad usage.
+const EXIT_USAGE: u8 = 2;
+
+/// Checks the world options' numbers (clap accepts NaN and negative values).
+fn check_world_args(args: &RenderArgs) -> Result<(), String> {
+    if let Some(s) = args.env_strength
+        && !(s.is_finite() && s >= 0.0)
+    {
+        return Err(format!(
+            "--env-strength {s}: the strength must be a finite number >= 0"
+        ));
+    }
+    if let Some(r) = args.env_rotation
+        && !r.is_finite()
+    {
+        return Err(format!(
+            "--env-rotation {r}: the angle must be a finite number"
+        ));
+    }
+    if let Some(c) = &args.background
+        && c.iter().any(|v| !(v.is_finite() && *v >= 0.0))
+    {
+        return Err(format!(
+            "--background {c:?}: the colour's components must be finite numbers >= 0"
+        ));
+    }
+    Ok(())
+}
+
+/// Replaces the scene's world with `--env` / `--background`, if given.
+fn apply_world_args(args: &RenderArgs, scene: &mut Scene) -> Result<(), String> {
+    if let Some(c) = &args.background {
+        scene.background = glam::Vec3::new(c[0], c[1], c[2]);
+        scene.world = scene::World {
+            name: "--background".into(),
+            ..Default::default()
+        };
+    }
+    if let Some(path) = &args.env {
+        let (img, bad) = scene::world::read_environment_image(path)?;
+        if bad > 0 {
+            scene.warnings.push(format!(
+                "{}: {bad} texel values are negative or not finite and read as 0",
+                path.display()
+            ));
+        }
+        scene.images.push(img);
+        let image = scene.images.len() - 1;
+        scene.background = glam::Vec3::ZERO;
+        scene.world = scene::World {
+            name: path.display().to_string(),
+            graph: Some(scene::world::environment_graph(
+                image,
+                args.env_strength.unwrap_or(1.0),
+                args.env_rotation.unwrap_or(0.0),
+            )),
+            ..Default::default()
+        };
+    }
+    Ok(())
+}
+
 fn load_scene(args: &RenderArgs) -> Result<Scene, String> {
+    let mut scene = load_scene_file(args)?;
+    apply_world_args(args, &mut scene)?;
+    Ok(scene)
+}
+
+fn load_scene_file(args: &RenderArgs) -> Result<Scene, String> {
     if let Some(name) = &args.builtin {
         return scene::builtin::by_name(name).ok_or_else(|| {
             format!(
@@ -191,6 +276,10 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
         }
         CANCEL.store(true, Ordering::SeqCst);
     });
+    if let Err(e) = check_world_args(args) {
+        eprintln!("tesela: error: {e}");
+        return ExitCode::from(EXIT_USAGE);
+    }
     let out = Mutex::new(BufWriter::with_capacity(1 << 20, std::io::stdout()));
     let send = |m: &Message| {
         let mut o = out.lock().unwrap_or_else(|e| e.into_inner());
@@ -285,14 +374,18 @@ fn prepare(scene: tesela::scene::Scene, choice: LightChoice, threads: usize) -> 
 }
 
 fn light_choice(args: &RenderArgs) -> LightChoice {
-    if args.light_choice == "uniform" {
-        LightChoice::Uniform
-    } else {
-        LightChoice::Power
+    match args.light_choice.as_str() {
+        "uniform" => LightChoice::Uniform,
+        "flat" => LightChoice::Flat,
+        _ => LightChoice::Power,
     }
 }
 
 fn run_render(args: &RenderArgs) -> ExitCode {
+    if let Err(e) = check_world_args(args) {
+        eprintln!("tesela: error: {e}");
+        return ExitCode::from(EXIT_USAGE);
+    }
     let scene = match load_scene(args) {
         Ok(s) => s,
         Err(e) => {
@@ -443,6 +536,26 @@ fn run_info(path: &Path) -> ExitCode {
                 println!("  bounds: {lo:?} .. {hi:?}");
             }
             println!("  background: {:?}", s.background);
+            let w = &s.world;
+            if w.graph.is_some() || !w.visible_camera {
+                println!(
+                    "  world '{}': {}, sampling {:?}{}",
+                    w.name,
+                    match &w.graph {
+                        Some(g) => format!("node graph of {} nodes", g.nodes.len()),
+                        None => "constant colour".into(),
+                    },
+                    w.sampling,
+                    if w.visible_camera {
+                        ""
+                    } else {
+                        ", hidden from the camera"
+                    }
+                );
+            }
+            if s.settings.film_transparent {
+                println!("  film: transparent");
+            }
             for w in &s.warnings {
                 println!("  warning: {w}");
             }
@@ -478,7 +591,7 @@ fn main() -> ExitCode {
             },
             None => {
                 eprintln!("tesela: error: unknown built-in scene `{name}`");
-                ExitCode::from(2)
+                ExitCode::from(EXIT_USAGE)
             }
         },
     }

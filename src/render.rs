@@ -157,24 +157,48 @@ fn render_pixel(
     let pixel_index = py as u64 * opts.width as u64 + px as u64;
     let mut sum = Vec3::ZERO;
     let mut accepted = 0u32;
+    // Samples where the camera sees nothing (outside a fisheye's circle): black.
+    let mut empty = 0u32;
+    // With a transparent film: the summed coverage of the accepted samples (their alpha).
+    let mut coverage = 0.0f32;
+    let transparent = scene.scene.settings.film_transparent;
+    let lens = camera.has_lens();
     for s in 0..opts.spp {
         ctx.sampler = SobolSampler::new(opts.seed, pixel_index, s as u64);
+        // Dimension 0: the pixel filter; 1: the lens, only for cameras with depth of field.
         let film = Vec2::new(px as f32, py as f32) + ctx.sampler.next_2d();
-        let (o, d) = camera.ray(film);
-        let l = integrator.li(scene, ctx, o, d);
+        let u_lens = if lens {
+            ctx.sampler.next_2d()
+        } else {
+            Vec2::ZERO
+        };
+        let Some(ray) = camera.ray(film, u_lens) else {
+            empty += 1;
+            continue;
+        };
+        // The integrators trace camera rays without an end yet: `ray.tmax` (the far clip
+        // distance) is not applied.
+        let l = integrator.li(scene, ctx, ray.o, ray.d);
         if l.is_finite() && l.min_element() >= 0.0 {
             sum += l;
             accepted += 1;
+            if transparent {
+                coverage += scene.camera_coverage(ctx, ray.o, ray.d);
+            }
         } else {
             *rejected += 1;
         }
     }
-    let c = if accepted > 0 {
-        sum / accepted as f32
+    let n = accepted + empty;
+    let c = if n > 0 { sum / n as f32 } else { Vec3::ZERO };
+    // An opaque film, as Cycles' without "Transparent": alpha 1 everywhere. A transparent
+    // one (`render.film_transparent`): the mean coverage (`RenderScene::camera_coverage`).
+    let alpha = if transparent && n > 0 {
+        coverage / n as f32
     } else {
-        Vec3::ZERO
+        1.0
     };
-    [c.x, c.y, c.z, 1.0]
+    [c.x, c.y, c.z, alpha]
 }
 
 /// What every render with `opts` starts from.

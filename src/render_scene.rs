@@ -2,13 +2,19 @@
 //! distribution, with the surface queries the integrators need.
 
 use crate::accel::{Accel, Hit, Traversal, offset_origin};
+use crate::emitter::light_bvh::LightBvh;
+use crate::emitter::light_tree::LightBounds;
 use crate::emitter::{
-    AreaEmitter, Background, Directional, Emitter, EmitterInstance, EmitterQueryRecord,
-    LightChoice, LightSampler, PointLight, SpotLight,
+    AreaEmitter, Directional, Emitter, EmitterInstance, EmitterQueryRecord, LightChoice,
+    LightSampler, PointLight, SpotLight,
 };
+use crate::emitter::{AreaLight, SphereLight};
 use crate::frame::Frame;
 use crate::integrator::MAX_TRANSPARENT;
+use crate::integrator::mis_weight;
 use crate::scene::{Light, Scene};
+use crate::scene::{LightShape, LightVisibility};
+use crate::shading::globals::ray;
 use crate::shading::globals::{ShadeEnv, ShaderGlobals, to_blender};
 use crate::shading::{ClosureKind, Program};
 use glam::{Mat4, Vec2, Vec3};
@@ -108,6 +114,9 @@ pub struct Ctx {
     /// What kind of ray the current path segment is (Light Path node bits), set when a BSDF
     /// is sampled; camera rays are recognised by their depth.
     pub ray_flags: u32,
+    /// Path vertex the current ray leads to (1: a camera ray), set by the integrators'
+    /// `trace_emitted`: what the world's Light Path node reads as the ray depth.
+    pub depth: u32,
     /// Rays cast: camera, bounce and shadow rays, and the last segments of paths however
     /// they are answered ([`RenderScene::emission_along`] may need no traversal at all).
     pub rays: u64,
@@ -124,6 +133,7 @@ impl Ctx {
             sampler,
             shade: Default::default(),
             ray_flags: 0,
+            depth: 1,
             rays: 0,
             log: None,
             trav: Traversal::default(),
@@ -158,6 +168,14 @@ pub struct RenderScene {
     mesh_emitter: Vec<Option<u32>>,
     /// Index of the background emitter, if the background is not black.
     pub background: Option<u32>,
+    /// Which rays see each emitter (the default for everything but Blender lights).
+    visibility: Vec<LightVisibility>,
+    /// Emitters with a finite shape rays can hit (lights with a radius, area lights), which
+    /// are not in `accel`: lights never occlude. Indexed by `light_bvh`'s items.
+    light_shapes: Vec<u32>,
+    light_bvh: LightBvh,
+    /// Distant lights of non-zero angle, which rays leaving the scene can meet.
+    suns: Vec<u32>,
     pub lights: LightSampler,
     /// Radius of the scene's bounding sphere.
     pub radius: f32,
@@ -218,7 +236,12 @@ impl RenderScene {
                 )),
             }
         }
+        let mut visibility = vec![LightVisibility::default(); emitters.len()];
         for l in &scene.lights {
+            visibility.push(match l {
+                Light::Blender { visibility, .. } => *visibility,
+                _ => LightVisibility::default(),
+            });
             emitters.push(match *l {
                 Light::Point {
                     position,
@@ -243,18 +266,40 @@ impl RenderScene {
                     irradiance,
                     angle,
                 } => EmitterInstance::Directional(Directional::new(direction, irradiance, angle)),
+                Light::Blender { shape, .. } => blender_emitter(&shape),
             });
         }
         let mut background = None;
-        if scene.background.max_element() > 0.0 {
+        if let Some(world) =
+            crate::emitter::environment::world_emitter(&scene, camera_to_world, &mut warnings)
+        {
             background = Some(emitters.len() as u32);
-            emitters.push(EmitterInstance::Background(Background {
-                radiance: scene.background,
-            }));
+            emitters.push(world);
         }
+        visibility.resize(emitters.len(), LightVisibility::default());
+        let (mut light_shapes, mut bounds, mut suns) = (Vec::new(), Vec::new(), Vec::new());
+        for (i, e) in emitters.iter().enumerate() {
+            match e {
+                EmitterInstance::Sphere(s) => {
+                    light_shapes.push(i as u32);
+                    bounds.push((s.position - s.radius, s.position + s.radius));
+                }
+                EmitterInstance::AreaLight(a) if !a.is_delta() => {
+                    light_shapes.push(i as u32);
+                    let c = a.corners();
+                    let lo = c.iter().fold(c[0], |m, p| m.min(*p));
+                    let hi = c.iter().fold(c[0], |m, p| m.max(*p));
+                    bounds.push((lo, hi));
+                }
+                EmitterInstance::Directional(d) if !d.is_delta() => suns.push(i as u32),
+                _ => {}
+            }
+        }
+        let light_bvh = LightBvh::new(&bounds);
         let emitter_accel = emitter_accel(&scene, &mesh_emitter, n);
         let powers: Vec<f32> = emitters.iter().map(|e| e.power(&scene, radius)).collect();
-        let lights = LightSampler::new(&powers, choice);
+        let bounds: Vec<_> = emitters.iter().map(|e| light_bounds(&scene, e)).collect();
+        let lights = LightSampler::with_bounds(&powers, &bounds, choice);
         scene.warnings.extend(warnings);
         let passes = programs.iter().any(|p| p.may_pass());
         RenderScene {
@@ -268,8 +313,151 @@ impl RenderScene {
             emitters,
             mesh_emitter,
             background,
+            visibility,
+            light_shapes,
+            light_bvh,
+            suns,
             lights,
             radius,
+        }
+    }
+
+    /// Whether a ray leaving path vertex `depth - 1` with Light Path bits `flags` sees
+    /// emitter `e` when it meets its shape (Cycles: camera rays the lights visible to the
+    /// camera; other rays those with multiple importance sampling, unless the kind of
+    /// scattering that made the ray is excluded).
+    #[inline]
+    fn ray_sees(&self, e: u32, depth: u32, flags: u32) -> bool {
+        let v = &self.visibility[e as usize];
+        if depth <= 1 {
+            return v.camera;
+        }
+        let glossy_reflection = ray::GLOSSY | ray::REFLECTION;
+        let diffuse_ok = v.diffuse || flags & ray::DIFFUSE == 0;
+        let glossy_ok = v.glossy || flags & glossy_reflection != glossy_reflection;
+        let transmission_ok = v.transmission || flags & ray::TRANSMISSION == 0;
+        v.mis && diffuse_ok && glossy_ok && transmission_ok
+    }
+
+    /// Whether emitter sampling of light `e` reaches a closure of the kinds `class` (Light Path
+    /// bits `DIFFUSE`, `GLOSSY`, `TRANSMISSION`; a closure of several kinds is excluded only
+    /// when all are, as Cycles treats glass).
+    #[inline]
+    pub fn light_reaches(&self, e: u32, class: u32) -> bool {
+        let v = &self.visibility[e as usize];
+        (class & ray::DIFFUSE != 0 && v.diffuse)
+            || (class & ray::GLOSSY != 0 && v.glossy)
+            || (class & ray::TRANSMISSION != 0 && v.transmission)
+    }
+
+    /// Whether shadow rays towards light `e` test occlusion.
+    #[inline]
+    pub fn casts_shadow(&self, e: u32) -> bool {
+        self.visibility[e as usize].cast_shadow
+    }
+
+    /// Whether emitter samples of light `e` are weighted against BSDF sampling (a light that
+    /// rays can hit, with multiple importance sampling on).
+    #[inline]
+    pub fn light_uses_mis(&self, e: u32) -> bool {
+        !self.emitters[e as usize].is_delta() && self.visibility[e as usize].mis
+    }
+
+    /// Whether the scene has lights whose shapes rays can meet (radius, area or angle).
+    #[inline]
+    pub fn has_light_shapes(&self) -> bool {
+        !self.light_shapes.is_empty() || !self.suns.is_empty()
+    }
+
+    /// The radiance of the Blender lights' shapes that the ray `o + t d` (unit `d`) meets for
+    /// `t ∈ (0, tmax)` — and, when `tmax` is infinite, of the suns it leaves the scene towards —
+    /// for a ray leaving path vertex `depth - 1` (Light Path bits in `ctx.ray_flags`), each
+    /// weighted against emitter sampling by the power heuristic with the BSDF density
+    /// `bsdf_pdf` (infinite: weight 1). Lights are transparent: a ray passes through every one
+    /// it meets. With `occlusion`, `tmax` is not the first surface's distance and each light
+    /// met is tested for what lies before it.
+    #[allow(clippy::too_many_arguments)]
+    pub fn lights_on_ray(
+        &self,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        tmax: f32,
+        depth: u32,
+        bsdf_pdf: f32,
+        occlusion: bool,
+    ) -> Vec3 {
+        if !self.has_light_shapes() {
+            return Vec3::ZERO;
+        }
+        let flags = ctx.ray_flags;
+        let mut hits = [(0u32, 0.0f32, Vec3::ZERO); 8];
+        let mut n = 0;
+        self.light_bvh.visit(o, d, tmax, |k| {
+            let e = self.light_shapes[k as usize];
+            if n == hits.len() || !self.ray_sees(e, depth, flags) {
+                return;
+            }
+            let hit = match &self.emitters[e as usize] {
+                EmitterInstance::Sphere(s) => s.intersect(o, d, tmax),
+                EmitterInstance::AreaLight(a) => a.intersect(o, d, tmax).map(|t| (t, a.normal)),
+                _ => None,
+            };
+            if let Some((t, normal)) = hit {
+                hits[n] = (e, t, normal);
+                n += 1;
+            }
+        });
+        let mut sum = Vec3::ZERO;
+        for &(e, t, normal) in &hits[..n] {
+            let rec = EmitterQueryRecord {
+                ref_p: o,
+                p: o + d * t,
+                n: normal,
+                ng: normal,
+                wi: d,
+                dist: t,
+                ..Default::default()
+            };
+            let le = self.emitters[e as usize].eval(&self.scene, &rec);
+            if le == Vec3::ZERO {
+                continue;
+            }
+            let tr = if occlusion {
+                self.segment_transmittance(ctx, o, d, t)
+            } else {
+                Vec3::ONE
+            };
+            sum += le * tr * self.forward_weight(e, &rec, bsdf_pdf);
+        }
+        if tmax.is_infinite() {
+            for &e in &self.suns {
+                if !self.ray_sees(e, depth, flags) {
+                    continue;
+                }
+                let rec = EmitterQueryRecord::towards(o, d);
+                let le = self.emitters[e as usize].eval(&self.scene, &rec);
+                if le == Vec3::ZERO {
+                    continue;
+                }
+                let tr = if occlusion {
+                    self.segment_transmittance(ctx, o, d, f32::INFINITY)
+                } else {
+                    Vec3::ONE
+                };
+                sum += le * tr * self.forward_weight(e, &rec, bsdf_pdf);
+            }
+        }
+        sum
+    }
+
+    /// MIS weight of light `e` met by a BSDF-sampled ray of density `bsdf_pdf`.
+    #[inline]
+    fn forward_weight(&self, e: u32, rec: &EmitterQueryRecord, bsdf_pdf: f32) -> f32 {
+        if bsdf_pdf.is_infinite() {
+            1.0
+        } else {
+            mis_weight(bsdf_pdf, self.light_pdf(e, rec))
         }
     }
 
@@ -296,7 +484,8 @@ impl RenderScene {
             return self.emission_through(ctx, o, d);
         }
         let Some(emissive) = &self.emitter_accel else {
-            return self.emission_at(self.intersect(ctx, o, d).as_ref(), o, d);
+            let (depth, flags) = (ctx.depth, ctx.ray_flags);
+            return self.emission_at(self.intersect(ctx, o, d).as_ref(), o, d, depth, flags);
         };
         ctx.cast(o, d, f32::INFINITY, RayKind::Emission);
         if let Some(hit) = emissive.intersect_with(&mut ctx.trav, o, d, 0.0, f32::INFINITY) {
@@ -316,7 +505,7 @@ impl RenderScene {
         if (self.accel).occluded_with(&mut ctx.trav, o, d, 0.0, f32::INFINITY) {
             return None;
         }
-        self.background_radiance(d, o)
+        self.background_radiance(d, o, ctx.depth, ctx.ray_flags)
     }
 
     /// [`RenderScene::emission_along`] in a scene with transparent surfaces: the first emission
@@ -334,7 +523,7 @@ impl RenderScene {
                 },
                 None => {
                     return self
-                        .background_radiance(d, o)
+                        .background_radiance(d, o, ctx.depth, ctx.ray_flags)
                         .map(|(e, le, r)| (e, le * tr, r));
                 }
             };
@@ -379,8 +568,8 @@ impl RenderScene {
                 Vec3::ZERO
             };
         }
-        let mut o = offset_origin(p, ng, rec.wi);
-        let (d, mut tmax) = if rec.dist.is_finite() {
+        let o = offset_origin(p, ng, rec.wi);
+        let (d, tmax) = if rec.dist.is_finite() {
             let target = offset_origin(rec.p, rec.ng, -rec.wi);
             let v = target - o;
             let dist = v.length();
@@ -391,6 +580,21 @@ impl RenderScene {
         } else {
             (rec.wi, f32::INFINITY)
         };
+        self.segment_transmittance(ctx, o, d, tmax)
+    }
+
+    /// The transmittance of the segment `o + t d`, `t ∈ (0, tmax)`: 1 or 0 in opaque scenes,
+    /// the product of the transparent surfaces' transmittance otherwise.
+    fn segment_transmittance(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32) -> Vec3 {
+        if !self.passes {
+            ctx.cast(o, d, tmax, RayKind::Any);
+            return if self.accel.occluded_with(&mut ctx.trav, o, d, 0.0, tmax) {
+                Vec3::ZERO
+            } else {
+                Vec3::ONE
+            };
+        }
+        let (mut o, mut tmax) = (o, tmax);
         let mut tr = Vec3::ONE;
         for _ in 0..=MAX_TRANSPARENT {
             ctx.cast(o, d, tmax, RayKind::Closest);
@@ -590,28 +794,76 @@ impl RenderScene {
     }
 
     /// The radiance a ray from `o` along `d` meets at `hit`: that surface's emission, or the
-    /// background's if the ray escaped (`hit` is `None`).
+    /// background's if the ray escaped (`hit` is `None`; the ray leads to path vertex `depth`
+    /// and has Light Path bits `flags`).
     #[inline]
-    pub fn emission_at(&self, hit: Option<&Intersection>, o: Vec3, d: Vec3) -> Emitted {
+    pub fn emission_at(
+        &self,
+        hit: Option<&Intersection>,
+        o: Vec3,
+        d: Vec3,
+        depth: u32,
+        flags: u32,
+    ) -> Emitted {
         match hit {
             Some(its) => self.emitted(its, o),
-            None => self.background_radiance(d, o),
+            None => self.background_radiance(d, o, depth, flags),
         }
     }
 
-    /// Background radiance for a ray leaving the scene along `d` from `from`.
+    /// Background radiance for a ray leaving the scene along `d` from `from`, leading to path
+    /// vertex `depth` with Light Path bits `flags`. Camera rays see nothing when the world is
+    /// hidden from the camera or the film is transparent.
     #[inline]
-    pub fn background_radiance(&self, d: Vec3, from: Vec3) -> Emitted {
+    pub fn background_radiance(&self, d: Vec3, from: Vec3, depth: u32, flags: u32) -> Emitted {
         let b = self.background?;
+        if flags & crate::shading::globals::ray::CAMERA != 0
+            && (!self.scene.world.visible_camera || self.scene.settings.film_transparent)
+        {
+            return None;
+        }
         let rec = EmitterQueryRecord::towards(from, d);
-        Some((b, self.emitters[b as usize].eval(&self.scene, &rec), rec))
+        let le = match &self.emitters[b as usize] {
+            EmitterInstance::Environment(env) => env.radiance(&self.scene, d, depth, flags),
+            e => e.eval(&self.scene, &rec),
+        };
+        Some((b, le, rec))
+    }
+
+    /// The film's coverage along a camera ray (its alpha): 1 without `film_transparent`;
+    /// with it, 1 where the ray meets an opaque surface, 0 where it escapes to the world, and
+    /// one minus the mean transmittance of the transparent surfaces it passes on the way out
+    /// (Cycles' `1 - average(throughput)`). Deterministic: it draws no random numbers.
+    pub fn camera_coverage(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> f32 {
+        if !self.scene.settings.film_transparent {
+            return 1.0;
+        }
+        let mut tr = Vec3::ONE;
+        let mut p = o;
+        for _ in 0..=MAX_TRANSPARENT {
+            let Some(its) = self.trace(ctx, p, d, 1) else {
+                return (1.0 - (tr.x + tr.y + tr.z) / 3.0).clamp(0.0, 1.0);
+            };
+            let program = &self.programs[its.material as usize];
+            if !program.may_pass() {
+                return 1.0;
+            }
+            let g = self.globals(&its, d, 1, crate::shading::globals::ray::CAMERA);
+            tr *= program.transparency(&g, &self.shade_env(), &mut ctx.shade);
+            if tr.max_element() <= 0.0 {
+                return 1.0;
+            }
+            p = offset_origin(its.p, its.ng, d);
+        }
+        1.0
     }
 
     /// Light-selection probability times the emitter's solid-angle density of `rec` — the
     /// density of emitter sampling producing this direction, for MIS.
     #[inline]
     pub fn light_pdf(&self, emitter: u32, rec: &EmitterQueryRecord) -> f32 {
-        self.lights.pmf(emitter as usize) * self.emitters[emitter as usize].pdf(&self.scene, rec)
+        self.lights.pmf_at(rec.ref_p, emitter as usize)
+            * self.emitters[emitter as usize].pdf(&self.scene, rec)
     }
 
     /// Chooses an emitter and samples it from `ref_p`. Returns the record and the weight
@@ -624,10 +876,9 @@ impl RenderScene {
         u: Vec2,
     ) -> (u32, EmitterQueryRecord, Vec3) {
         let mut rec = EmitterQueryRecord::from_ref(ref_p);
-        if self.lights.is_empty() {
+        let Some((i, pmf)) = self.lights.sample_at(ref_p, u_choice) else {
             return (0, rec, Vec3::ZERO);
-        }
-        let (i, pmf) = self.lights.sample(u_choice);
+        };
         let w = self.emitters[i].sample(&self.scene, &mut rec, u);
         rec.pdf *= pmf;
         (i as u32, rec, w / pmf)
@@ -645,6 +896,108 @@ impl RenderScene {
 
     pub fn triangle_count(&self) -> usize {
         self.triangles
+    }
+}
+
+/// Where emitter `e` emits from and in which directions, for a light tree; `None` for
+/// emitters at infinity.
+fn light_bounds(scene: &Scene, e: &EmitterInstance) -> Option<LightBounds> {
+    use crate::emitter::spot::spot_cos_outer;
+    let spot = |lo: Vec3, hi: Vec3, axis: Vec3, f: &crate::scene::SpotFalloff| LightBounds {
+        lo,
+        hi,
+        phi: 1.0,
+        axis,
+        theta_o: spot_cos_outer(f).clamp(-1.0, 1.0).acos(),
+        theta_e: 0.0,
+    };
+    Some(match e {
+        EmitterInstance::Area(a) => {
+            let m = &scene.meshes[a.mesh];
+            let lo = m.positions.iter().fold(Vec3::INFINITY, |l, p| l.min(*p));
+            let hi = m
+                .positions
+                .iter()
+                .fold(Vec3::NEG_INFINITY, |h, p| h.max(*p));
+            LightBounds::omni(lo, hi, 1.0)
+        }
+        EmitterInstance::Point(p) => LightBounds::omni(p.position, p.position, 1.0),
+        EmitterInstance::Spot(s) => spot(s.position, s.position, s.direction, &s.falloff),
+        EmitterInstance::Sphere(s) => {
+            let (lo, hi) = (s.position - s.radius, s.position + s.radius);
+            match &s.spot {
+                Some((axis, f)) => spot(lo, hi, *axis, f),
+                None => LightBounds::omni(lo, hi, 1.0),
+            }
+        }
+        EmitterInstance::AreaLight(a) => {
+            let c = a.corners();
+            LightBounds {
+                lo: c.iter().fold(c[0], |m, p| m.min(*p)),
+                hi: c.iter().fold(c[0], |m, p| m.max(*p)),
+                phi: 1.0,
+                axis: a.normal,
+                theta_o: 0.0,
+                theta_e: a.half_spread(),
+            }
+        }
+        _ => return None,
+    })
+}
+
+/// The emitter of a Blender light. A point or spot light of zero radius (or one so small that
+/// its radiance overflows) stays a delta light.
+fn blender_emitter(shape: &LightShape) -> EmitterInstance {
+    use std::f32::consts::PI;
+    match *shape {
+        LightShape::Point {
+            position,
+            intensity,
+            radius,
+            soft_falloff,
+            spot,
+        } => {
+            let radiance = intensity / (PI * radius * radius);
+            if radius > 0.0 && radiance.is_finite() {
+                return EmitterInstance::Sphere(SphereLight {
+                    position,
+                    radius,
+                    radiance,
+                    sphere: !soft_falloff,
+                    spot: spot.map(|(d, f)| (d.normalize(), f)),
+                });
+            }
+            match spot {
+                Some((direction, falloff)) => EmitterInstance::Spot(SpotLight {
+                    position,
+                    direction: direction.normalize(),
+                    intensity,
+                    falloff,
+                }),
+                None => EmitterInstance::Point(PointLight {
+                    position,
+                    intensity,
+                }),
+            }
+        }
+        LightShape::Sun {
+            direction,
+            irradiance,
+            angle,
+        } => EmitterInstance::Directional(Directional::new(direction, irradiance, angle)),
+        LightShape::Area {
+            center,
+            axis_u,
+            axis_v,
+            normal,
+            size_u,
+            size_v,
+            ellipse,
+            radiance,
+            spread,
+        } => EmitterInstance::AreaLight(AreaLight::new(
+            center, axis_u, axis_v, normal, size_u, size_v, ellipse, radiance, spread,
+        )),
     }
 }
 
@@ -679,7 +1032,8 @@ mod tests {
                 let o = lo - (hi - lo) * 0.05 + (hi - lo) * 1.1 * u;
                 let d = square_to_uniform_sphere(rng.next_2d());
                 let fast = rs.emission_along(&mut ctx, o, d);
-                let full = rs.emission_at(rs.intersect(&mut ctx, o, d).as_ref(), o, d);
+                let hit = rs.intersect(&mut ctx, o, d);
+                let full = rs.emission_at(hit.as_ref(), o, d, ctx.depth, ctx.ray_flags);
                 let full = full.filter(|(_, le, _)| *le != Vec3::ZERO);
                 match (&fast, &full) {
                     (Some((a, la, ra)), Some((b, lb, rb))) => {

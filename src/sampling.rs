@@ -79,6 +79,25 @@ pub fn square_to_uniform_triangle(s: Vec2) -> Vec2 {
     Vec2::new(1.0 - su, s.y * su)
 }
 
+/// Uniform point in the regular polygon of `corners ≥ 3` vertices inscribed in the unit circle,
+/// its vertices at angles `rotation ± π/corners + 2πk/corners` (an edge's midpoint at angle
+/// `rotation`), as Cycles' `regular_polygon_sample`: `u.x` picks one of the `corners`
+/// triangles fanning from the centre and is reused, with `u.y`, for a uniform point in it.
+/// Density `1/A` per unit area, `A = corners/2 · sin(2π/corners)`.
+#[inline]
+pub fn square_to_regular_polygon(u: Vec2, corners: u32, rotation: f32) -> Vec2 {
+    let n = corners as f32;
+    let corner = (u.x * n).floor().min(n - 1.0);
+    let t = square_to_uniform_triangle(Vec2::new(u.x * n - corner, u.y));
+    // Barycentric weights of the triangle's two outer vertices (at angles ±π/n before
+    // rotation); the centre takes the rest.
+    let (a, b) = (t.x, t.y);
+    let half = PI / n;
+    let p = Vec2::new((a + b) * half.cos(), (a - b) * half.sin());
+    let (s, c) = (rotation + corner * 2.0 * half).sin_cos();
+    Vec2::new(c * p.x - s * p.y, s * p.x + c * p.y)
+}
+
 /// A discrete distribution over `n` items proportional to non-negative weights (a CDF table).
 #[derive(Clone, Debug, Default)]
 pub struct DiscreteCdf {

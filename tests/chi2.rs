@@ -412,7 +412,7 @@ fn light_sampler_scene() -> Scene {
 #[test]
 fn light_sampler_power_and_uniform_choice() {
     let lum = |c: Vec3| 0.2126 * c.x as f64 + 0.7152 * c.y as f64 + 0.0722 * c.z as f64;
-    for (case, choice) in [LightChoice::Power, LightChoice::Uniform]
+    for (case, choice) in [LightChoice::Power, LightChoice::Flat, LightChoice::Uniform]
         .into_iter()
         .enumerate()
     {
@@ -441,7 +441,7 @@ fn light_sampler_power_and_uniform_choice() {
             );
         }
         let weights: Vec<f64> = match choice {
-            LightChoice::Power => expected_power.to_vec(),
+            LightChoice::Power | LightChoice::Flat => expected_power.to_vec(),
             LightChoice::Uniform => expected_power
                 .iter()
                 .map(|&p| if p > 0.0 { 1.0 } else { 0.0 })

@@ -672,7 +672,7 @@ fn structured_mutations_never_panic() {
     let (d, bin) = rich_doc();
     let s = load_from_slice(&glb(&bytes(&d), &bin), None, "rich.glb").unwrap();
     assert!(
-        s.camera.is_some() && s.lights.len() == 2 && s.meshes.len() == 3,
+        s.camera.is_some() && s.lights.len() == 3 && s.meshes.len() == 2,
         "{s:?}"
     );
     let mut rng = Lcg(99);

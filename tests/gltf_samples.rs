@@ -529,10 +529,17 @@ fn transmission_and_ior() {
     let opaque = material(&s, "Mat_Opaque");
     assert_eq!(opaque.transmission, 0.0);
     assert!((material(&s, "LabelMat").roughness - 0.8).abs() < 1e-6);
+    // KHR_materials_volume: 5 mm thick, clear (no attenuation): what a solid dielectric
+    // renders, so nothing to report.
+    let v = material(&s, "Mat_IOR_1.50").volume.expect("volume");
+    assert!((v.thickness - 0.005).abs() < 1e-9);
+    assert!(v.attenuation_distance.is_infinite());
     assert!(
-        s.warnings
+        !s.warnings
             .iter()
-            .any(|w| w.contains("KHR_materials_volume"))
+            .any(|w| w.contains("KHR_materials_volume")),
+        "{:?}",
+        s.warnings
     );
 }
 
@@ -817,5 +824,308 @@ fn load_from_slice_refuses_external_files_without_a_base_dir() {
     assert_eq!(
         load_from_slice(&bytes, None, "x.glb").unwrap().images.len(),
         1
+    );
+}
+
+// --- Renders of the samples whose materials use texture transforms, texture coordinate sets,
+// vertex colours and normal maps, checked at pixels whose expected look was verified by eye
+// against each sample's README (the view: an orthographic or perspective camera added to the
+// file, the lights as stated).
+
+/// Loads sample `rel` with its JSON changed by `edit` (resources still from its folder).
+fn edited_sample(dir: &Path, rel: &str, edit: impl FnOnce(&mut serde_json::Value)) -> Scene {
+    let p = dir.join(rel);
+    let mut doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+    edit(&mut doc);
+    let bytes = serde_json::to_vec(&doc).unwrap();
+    load_from_slice(&bytes, p.parent(), rel).unwrap_or_else(|e| panic!("{rel}: {e}"))
+}
+
+/// Adds a camera node (`camera` is the glTF camera object) at `at`, looking down -Z.
+fn add_camera(doc: &mut serde_json::Value, camera: serde_json::Value, at: [f32; 3]) {
+    doc["cameras"] = serde_json::json!([camera]);
+    let nodes = doc["nodes"].as_array_mut().unwrap();
+    nodes.push(serde_json::json!({ "camera": 0, "translation": at }));
+    let ni = nodes.len() - 1;
+    let scene = doc["scene"].as_u64().unwrap_or(0) as usize;
+    doc["scenes"][scene]["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(serde_json::json!(ni));
+}
+
+fn render_scene(s: Scene, integrator: &str, w: u32, h: u32, spp: u32) -> tesela::render::Image {
+    use tesela::render::{RenderOptions, render};
+    let rs = tesela::render_scene::RenderScene::new(s, Default::default());
+    let opts = RenderOptions {
+        width: w,
+        height: h,
+        spp,
+        max_depth: 2,
+        integrator: integrator.into(),
+        ..Default::default()
+    };
+    let (img, _) = render(
+        &rs,
+        &opts,
+        &std::sync::atomic::AtomicBool::new(false),
+        &|_, _, _| {},
+    )
+    .unwrap();
+    img
+}
+
+fn px(img: &tesela::render::Image, x: u32, y: u32) -> Vec3 {
+    let p = img.pixels[(y * img.width + x) as usize];
+    Vec3::new(p[0], p[1], p[2])
+}
+
+#[test]
+fn texture_transform_test_shows_every_arrow_on_its_green_marker() {
+    let Some(dir) = samples_dir() else { return };
+    let rel = "TextureTransformTest/glTF/TextureTransformTest.gltf";
+    // The six quads span x in [-1.6, 1.6], y in [-1.05, 1.05]: an orthographic view of
+    // [-1.7, 1.7] x [-1.275, 1.275] at 400x300, so world (x, y) is pixel
+    // ((x + 1.7) / 3.4 * 400, (1.275 - y) / 2.55 * 300).
+    let s = edited_sample(&dir, rel, |d| {
+        add_camera(
+            d,
+            serde_json::json!({ "type": "orthographic",
+                "orthographic": { "xmag": 1.7, "ymag": 1.275, "znear": 0.1, "zfar": 100 } }),
+            [0.0, 0.0, 5.0],
+        )
+    });
+    assert!(
+        !s.warnings
+            .iter()
+            .any(|w| w.contains("KHR_texture_transform")),
+        "{:?}",
+        s.warnings
+    );
+    let img = render_scene(s, "albedo", 400, 300, 4);
+    let at = |x: f32, y: f32| {
+        px(
+            &img,
+            ((x + 1.7) / 3.4 * 400.0) as u32,
+            ((1.275 - y) / 2.55 * 300.0) as u32,
+        )
+    };
+    let near = |c: Vec3, want: Vec3, what: &str| {
+        assert!(c.abs_diff_eq(want, 0.02), "{what}: {c}, expected {want}");
+    };
+    // Top row, the offsets: the UV texture's green (offset U), blue (V) and cyan (UV) quarters
+    // with the check marks, not the yellow "not supported" quarter (sRGB 0.76 = linear 0.527).
+    near(at(-1.5, 0.95), Vec3::new(0.0, 0.527, 0.0), "offset U");
+    near(at(-0.4, 0.95), Vec3::new(0.0, 0.0, 0.527), "offset V");
+    near(at(0.7, 0.95), Vec3::new(0.0, 0.527, 0.527), "offset UV");
+    // Rotation (quad at (-1.1, -0.55)): the arrow runs from the top-left corner towards the green
+    // marker at (-0.08, -0.52) of the quad; the unrotated arrow would lie on the diagonal
+    // towards the yellow marker.
+    near(at(-1.305, -0.761), Vec3::ZERO, "rotated arrow shaft");
+    near(
+        at(-0.95, -0.70),
+        Vec3::ONE,
+        "where the unrotated arrow would be",
+    );
+    // Scale (quad at (0, -0.55)): the arrow ends at the green marker near the quad's centre;
+    // beyond it, where the unscaled arrow would go on, the texture is white.
+    near(at(-0.1, -0.45), Vec3::ZERO, "scaled arrow shaft");
+    near(at(0.15, -0.7), Vec3::ONE, "beyond the scaled arrow");
+    // All three (quad at (1.1, -0.55)): the arrow crosses (0.85, -0.425) on its way to the
+    // green marker; the clamped grey border shows at the bottom right.
+    near(at(0.85, -0.425), Vec3::ZERO, "combined transform arrow");
+    let border = at(1.3, -0.75);
+    assert!(
+        border.x > 0.6 && border.x < 0.9,
+        "clamped grey border: {border}"
+    );
+}
+
+#[test]
+fn texture_coordinate_test_puts_each_corner_label_in_its_corner() {
+    let Some(dir) = samples_dir() else { return };
+    let rel = "TextureCoordinateTest/glTF/TextureCoordinateTest.gltf";
+    // Orthographic view of [-1.3, 1.3]^2 at 260x260: world (x, y) is pixel
+    // ((x + 1.3) * 100, (1.3 - y) * 100).
+    let s = edited_sample(&dir, rel, |d| {
+        add_camera(
+            d,
+            serde_json::json!({ "type": "orthographic",
+                "orthographic": { "xmag": 1.3, "ymag": 1.3, "znear": 0.1, "zfar": 100 } }),
+            [0.0, 0.0, 5.0],
+        )
+    });
+    let img = render_scene(s, "albedo", 260, 260, 4);
+    // The darkest pixel of a strip: the texture's corner checkers are black.
+    let darkest = |xs: std::ops::Range<u32>, ys: std::ops::Range<u32>| {
+        let mut m = f32::INFINITY;
+        for y in ys {
+            for x in xs.clone() {
+                m = m.min(px(&img, x, y).max_element());
+            }
+        }
+        m
+    };
+    // Top-left quad (x, y in [-1.2, -0.2] x [0.2, 1.2]): its checkers run along its outer top
+    // edge (pixel rows 10..16), not along its bottom edge (rows 104..110).
+    assert!(darkest(12..40, 10..16) < 0.1, "top-left checker");
+    assert!(
+        darkest(12..40, 104..110) > 0.5,
+        "nothing at the top-left quad's bottom"
+    );
+    // Bottom-right quad (x, y in [0.2, 1.2] x [-1.2, -0.2]): checkers at its outer bottom edge.
+    assert!(darkest(220..248, 244..250) < 0.1, "bottom-right checker");
+    assert!(
+        darkest(220..248, 150..156) > 0.5,
+        "nothing at the bottom-right quad's top"
+    );
+}
+
+#[test]
+fn box_vertex_colors_multiply_the_default_material() {
+    let Some(dir) = samples_dir() else { return };
+    let rel = "BoxVertexColors/glTF/BoxVertexColors.gltf";
+    // The unit cube [0, 1]^3 with COLOR_0 = position; seen from +Z (orthographic, [-0.1, 1.1]^2
+    // at 120x120), the front face z = 1 shows albedo (x, y, 1).
+    let s = edited_sample(&dir, rel, |d| {
+        add_camera(
+            d,
+            serde_json::json!({ "type": "orthographic",
+                "orthographic": { "xmag": 0.6, "ymag": 0.6, "znear": 0.1, "zfar": 100 } }),
+            [0.5, 0.5, 5.0],
+        )
+    });
+    assert!(s.materials[s.meshes[0].material].vertex_color);
+    let img = render_scene(s, "albedo", 120, 120, 4);
+    for (x, y) in [(0.1, 0.1), (0.9, 0.1), (0.5, 0.5), (0.2, 0.8), (0.9, 0.9)] {
+        let (pxx, pxy) = (
+            ((x + 0.1) / 1.2 * 120.0) as u32,
+            ((1.1 - y) / 1.2 * 120.0) as u32,
+        );
+        // The pixel centre's world position.
+        let cx = -0.1 + (pxx as f32 + 0.5) / 120.0 * 1.2;
+        let cy = 1.1 - (pxy as f32 + 0.5) / 120.0 * 1.2;
+        let c = px(&img, pxx, pxy);
+        assert!(
+            c.abs_diff_eq(Vec3::new(cx, cy, 1.0), 0.01),
+            "({cx}, {cy}): {c}"
+        );
+    }
+}
+
+#[test]
+fn box_with_spaces_normal_map_lights_the_faces_its_green_tilts_up() {
+    let Some(dir) = samples_dir() else { return };
+    let rel = "Box With Spaces/glTF/Box With Spaces.gltf";
+    // A white Lambertian box with the sample's normal map, seen from +Z, lit by a sun from
+    // above at a grazing 14 degrees to the front face. The logo is engraved: its grooves' lower
+    // walls (green > 0.5 in the map, normals tilted towards the image's top) face the light and
+    // are brighter than the flat face; the upper walls darker. An inverted green channel would
+    // turn that around.
+    let edit = |with_normals: bool| {
+        move |d: &mut serde_json::Value| {
+            let m = &mut d["materials"][0];
+            m["pbrMetallicRoughness"] =
+                serde_json::json!({ "metallicFactor": 0, "roughnessFactor": 1 });
+            m["extensions"] =
+                serde_json::json!({ "KHR_materials_specular": { "specularFactor": 0 } });
+            if !with_normals {
+                m.as_object_mut().unwrap().remove("normalTexture");
+            }
+            let th = (-76f32).to_radians();
+            d["extensionsUsed"] =
+                serde_json::json!(["KHR_lights_punctual", "KHR_materials_specular"]);
+            d["extensions"] = serde_json::json!({ "KHR_lights_punctual": { "lights": [
+                { "type": "directional", "intensity": 683.0 * 3.0 }] } });
+            let nodes = d["nodes"].as_array_mut().unwrap();
+            nodes.push(
+                serde_json::json!({ "rotation": [(th / 2.0).sin(), 0, 0, (th / 2.0).cos()],
+                "extensions": { "KHR_lights_punctual": { "light": 0 } } }),
+            );
+            let ni = nodes.len() - 1;
+            d["scenes"][0]["nodes"]
+                .as_array_mut()
+                .unwrap()
+                .push(serde_json::json!(ni));
+            add_camera(
+                d,
+                serde_json::json!({ "type": "orthographic",
+                    "orthographic": { "xmag": 1.0, "ymag": 1.0, "znear": 0.1, "zfar": 100 } }),
+                [0.0, 0.0, 5.0],
+            );
+        }
+    };
+    let s = edited_sample(&dir, rel, edit(true));
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    assert!(
+        s.meshes
+            .iter()
+            .all(|m| m.attrs.tangents.len() == m.positions.len()),
+        "MikkTSpace tangents"
+    );
+    // The normal map texel under each pixel of the front face (z = 1): found from the mesh.
+    let mesh = s.meshes[0].clone();
+    let nmap = {
+        let t = s.materials[mesh.material].normal_texture.unwrap();
+        s.images[s.textures[t.texture].image].clone()
+    };
+    let green_at = |x: f32, y: f32| -> Option<f32> {
+        for (ti, t) in mesh.indices.iter().enumerate() {
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+            if (a.z - 1.0).abs() > 1e-4 || (b.z - 1.0).abs() > 1e-4 || (c.z - 1.0).abs() > 1e-4 {
+                continue;
+            }
+            let (v0, v1, p) = (b - a, c - a, Vec3::new(x, y, 1.0) - a);
+            let d = v0.x * v1.y - v1.x * v0.y;
+            let b1 = (p.x * v1.y - v1.x * p.y) / d;
+            let b2 = (v0.x * p.y - p.x * v0.y) / d;
+            if b1 < 0.0 || b2 < 0.0 || b1 + b2 > 1.0 {
+                continue;
+            }
+            let uv = mesh.uv(0, ti as u32, b1, b2);
+            let tx = ((uv.x.rem_euclid(1.0)) * nmap.width as f32) as u32;
+            let ty = ((uv.y.rem_euclid(1.0)) * nmap.height as f32) as u32;
+            let texel = nmap.rgba8
+                [(ty.min(nmap.height - 1) * nmap.width + tx.min(nmap.width - 1)) as usize];
+            return Some(texel[1] as f32 / 255.0);
+        }
+        None
+    };
+    let n = 200;
+    let lit = render_scene(s, "direct_ems", n, n, 4);
+    let flat = render_scene(edited_sample(&dir, rel, edit(false)), "direct_ems", n, n, 4);
+    // Over the front face: pixels whose texel tilts up (green > 0.6) against down (< 0.4).
+    let (mut up, mut down) = (Vec::new(), Vec::new());
+    for y in 0..n {
+        for x in 0..n {
+            let (wx, wy) = (
+                -1.0 + (x as f32 + 0.5) / n as f32 * 2.0,
+                1.0 - (y as f32 + 0.5) / n as f32 * 2.0,
+            );
+            let Some(g) = green_at(wx, wy) else { continue };
+            let r = px(&lit, x, y).x / px(&flat, x, y).x.max(1e-6);
+            if g > 0.6 {
+                up.push(r);
+            } else if g < 0.4 {
+                down.push(r);
+            }
+        }
+    }
+    let mean = |v: &[f32]| v.iter().sum::<f32>() / v.len() as f32;
+    assert!(
+        up.len() > 20 && down.len() > 20,
+        "{} / {}",
+        up.len(),
+        down.len()
+    );
+    assert!(
+        mean(&up) > 1.5,
+        "upward-tilted texels are brighter: {}",
+        mean(&up)
+    );
+    assert!(
+        mean(&down) < 0.7,
+        "downward-tilted texels are darker: {}",
+        mean(&down)
     );
 }

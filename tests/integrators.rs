@@ -69,6 +69,7 @@ fn camera(to_world: Mat4, yfov_deg: f32) -> Option<Camera> {
         },
         to_world,
         aspect: None,
+        ..Default::default()
     })
 }
 
@@ -309,6 +310,7 @@ fn light_touching_a_wall_does_not_leak() {
         projection: Projection::Orthographic { ymag: 0.1 },
         to_world: Mat4::from_translation(v(-0.11, 0.4, 0.0)) * Mat4::from_rotation_x(-PI / 2.0),
         aspect: None,
+        ..Default::default()
     });
     for name in ALL {
         let px = render_with(s.clone(), &opts(name, 16, 16, 2, 11), LightChoice::Power);

@@ -936,6 +936,7 @@ fn camera_inside_objects() {
             projection: Projection::Perspective { yfov: 1.2 },
             to_world: look_at(p, t),
             aspect: None,
+            ..Default::default()
         })
     };
     s.camera = cam_at(v(0.0, 0.5, 0.5), v(0.0, 0.5, -1.0));
@@ -960,6 +961,7 @@ fn camera_inside_objects() {
         projection: Projection::Orthographic { ymag: 0.3 },
         to_world: Mat4::from_translation(v(0.0, 0.5, 0.0)),
         aspect: None,
+        ..Default::default()
     });
     render_all("orthographic inside", &s);
 }

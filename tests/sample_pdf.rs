@@ -671,6 +671,9 @@ fn kind(e: &EmitterInstance) -> &'static str {
         EmitterInstance::Spot(_) => "spot",
         EmitterInstance::Directional(_) => "directional",
         EmitterInstance::Background(_) => "background",
+        EmitterInstance::Environment(_) => "environment",
+        EmitterInstance::Sphere(_) => "sphere",
+        EmitterInstance::AreaLight(_) => "area light",
     }
 }
 

@@ -99,6 +99,7 @@ fn shadow_scene(panel: Option<Material>) -> Scene {
         },
         to_world: look,
         aspect: None,
+        ..Default::default()
     });
     s
 }
@@ -160,6 +161,7 @@ fn through_panel(panel: Material) -> Scene {
         },
         to_world: Mat4::IDENTITY,
         aspect: None,
+        ..Default::default()
     });
     s
 }

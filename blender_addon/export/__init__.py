@@ -16,7 +16,7 @@ if "gltf" in locals():  # reload support (F3 > Reload Scripts): submodules first
 
 from . import common, buffer, images, material, mesh, light, camera, world, gltf  # noqa: E402,F401
 from .buffer import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT, UINT, Buffer  # noqa: E402,F401
-from .camera import camera_fields, camera_matrix  # noqa: E402,F401
+from .camera import camera_extension, camera_fields, camera_matrix  # noqa: E402,F401
 from .common import ExportCancelled, color3, finite, gltf_matrix, matrix  # noqa: E402,F401
 from .gltf import ExportResult, border_region, render_size, write_gltf  # noqa: E402,F401
 from .images import ImageTable, Textures, write_png  # noqa: E402,F401

@@ -1,11 +1,12 @@
 # SPDX-License-Identifier: MIT
-"""Blender cameras -> glTF cameras at the render resolution."""
+"""Blender cameras -> glTF cameras at the render resolution, and TESELA_camera (their native
+data: sensor fit, shift, clipping, depth of field, panoramas)."""
 
 import math
 
 import numpy as np
 
-from .common import matrix
+from .common import finite, matrix
 
 
 def camera_fields(cam_data, width, height):
@@ -53,3 +54,66 @@ def camera_matrix(obj):
         if n > 0:
             m[:3, i] /= n
     return m
+
+
+# Panoramic settings: on the camera since Blender 4.0, on its Cycles settings (cam.cycles) before.
+PANORAMA_FIELDS = (
+    "fisheye_fov", "fisheye_lens", "latitude_min", "latitude_max", "longitude_min",
+    "longitude_max", "fisheye_polynomial_k0", "fisheye_polynomial_k1", "fisheye_polynomial_k2",
+    "fisheye_polynomial_k3", "fisheye_polynomial_k4", "central_cylindrical_range_u_min",
+    "central_cylindrical_range_u_max", "central_cylindrical_range_v_min",
+    "central_cylindrical_range_v_max", "central_cylindrical_radius")
+
+
+def _panorama_setting(cam_data, name):
+    if hasattr(cam_data, name):
+        return getattr(cam_data, name)
+    return getattr(getattr(cam_data, "cycles", None), name, None)
+
+
+def focus_distance(cam_obj):
+    """The depth of field's focus distance as Cycles takes it: `dof.focus_distance`, or with a
+    focus object (or one of its bones) the distance of its origin along the camera's view axis."""
+    dof = cam_obj.data.dof
+    target = dof.focus_object
+    if target is None:
+        return finite(dof.focus_distance)
+    m = matrix(target.matrix_world)
+    sub = getattr(dof, "focus_subtarget", "")
+    pose = getattr(target, "pose", None)
+    if sub and pose is not None and sub in pose.bones:
+        m = m @ matrix(pose.bones[sub].matrix)
+    cm = camera_matrix(cam_obj)
+    view = cm[:3, 2] / max(np.linalg.norm(cm[:3, 2]), 1e-30)
+    return finite(abs(float(np.dot(view, cm[:3, 3] - m[:3, 3]))))
+
+
+def camera_extension(cam_obj, warnings):
+    """TESELA_camera (docs/extensions.md) for a Blender camera object: its native data, the
+    renderer applies Cycles' formulas to it."""
+    cd = cam_obj.data
+    ext = {"type": cd.type,
+           "lens": finite(cd.lens), "sensor_width": finite(cd.sensor_width),
+           "sensor_height": finite(cd.sensor_height), "sensor_fit": cd.sensor_fit,
+           "ortho_scale": finite(cd.ortho_scale),
+           "shift_x": finite(cd.shift_x), "shift_y": finite(cd.shift_y),
+           "clip_start": finite(cd.clip_start), "clip_end": finite(cd.clip_end, 1e30)}
+    if cd.type == "CUSTOM":
+        warnings.append("camera '%s': custom (OSL) cameras are not supported; rendering it as "
+                        "a perspective camera" % cam_obj.name)
+    if cd.type == "PANO":
+        pano = _panorama_setting(cd, "panorama_type")
+        if pano is not None:
+            ext["panorama_type"] = pano
+        for name in PANORAMA_FIELDS:
+            v = _panorama_setting(cd, name)
+            if v is not None:
+                ext[name] = finite(v)
+    dof = getattr(cd, "dof", None)
+    if dof is not None and dof.use_dof:
+        ext["dof"] = {"focus_distance": focus_distance(cam_obj),
+                      "aperture_fstop": finite(dof.aperture_fstop),
+                      "aperture_blades": int(dof.aperture_blades),
+                      "aperture_rotation": finite(dof.aperture_rotation),
+                      "aperture_ratio": finite(dof.aperture_ratio, 1.0)}
+    return ext

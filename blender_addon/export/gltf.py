@@ -9,7 +9,7 @@ import numpy as np
 
 from .. import compat
 from .buffer import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT, UINT, Buffer
-from .camera import camera_fields, camera_matrix
+from .camera import camera_extension, camera_fields, camera_matrix
 from .common import ExportCancelled, gltf_matrix, matrix
 from .images import ImageTable, Textures
 from .light import convert_light
@@ -178,23 +178,22 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
 
     cam = camera if camera is not None else scene.camera
     if cam is not None and cam.type == "CAMERA":
-        cd = cam.data
-        if cd.type == "PANO":
-            warnings.append("camera '%s': panoramic cameras are not supported; rendering it as "
-                            "a perspective camera" % cam.name)
-        if abs(cd.shift_x) > 1e-6 or abs(cd.shift_y) > 1e-6:
-            warnings.append("camera '%s': lens shift is ignored" % cam.name)
-        if getattr(getattr(cd, "dof", None), "use_dof", False):
-            warnings.append("camera '%s': depth of field is ignored" % cam.name)
+        r = scene.render
+        if abs(r.pixel_aspect_x - r.pixel_aspect_y) > 1e-6 * max(r.pixel_aspect_x, 1.0):
+            warnings.append("pixel aspect %g:%g is not supported; Tesela renders square pixels"
+                            % (r.pixel_aspect_x, r.pixel_aspect_y))
         doc["cameras"].append(dict(camera_fields(cam.data, width, height), name=cam.data.name))
-        add_node({"name": cam.name, "camera": 0, "matrix": gltf_matrix(camera_matrix(cam))})
+        add_node({"name": cam.name, "camera": 0, "matrix": gltf_matrix(camera_matrix(cam)),
+                  "extensions": {"TESELA_camera": camera_extension(cam, warnings)}})
+        used_ext.add("TESELA_camera")
         res.has_camera = True
 
-    world = convert_world(scene.world, warnings)
+    world = convert_world(scene.world, warnings, images)
     ext_root = {"TESELA_world": world}
     used_ext.add("TESELA_world")
     if render_settings is not None:
-        ext_root["TESELA_render"] = render_settings
+        ext_root["TESELA_render"] = dict(
+            render_settings, film_transparent=bool(getattr(scene.render, "film_transparent", False)))
         used_ext.add("TESELA_render")
     if khr_lights:
         ext_root["KHR_lights_punctual"] = {"lights": khr_lights}

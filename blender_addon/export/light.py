@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: MIT
-"""Blender lights -> TESELA_light (native parameters) plus a KHR_lights_punctual copy."""
+"""Blender lights -> TESELA_light (native parameters, ray visibility) plus a KHR_lights_punctual
+copy. The renderer applies Cycles' formulas; this module only reads Blender's settings."""
 
 import math
 
@@ -21,6 +22,7 @@ def convert_light(light, obj, matrix=None, warnings=None):
         ext["power"] = energy
     if t in ("POINT", "SPOT"):
         ext["radius"] = finite(getattr(light, "shadow_soft_size", 0.0))
+        ext["soft_falloff"] = compat.light_soft_falloff(light)
     if t == "SPOT":
         ext["spot_size"] = finite(light.spot_size)
         ext["spot_blend"] = finite(light.spot_blend)
@@ -30,9 +32,7 @@ def convert_light(light, obj, matrix=None, warnings=None):
         ext["shape"] = light.shape
         ext["size"] = finite(light.size)
         ext["size_y"] = finite(light.size_y) if light.shape in ("RECTANGLE", "ELLIPSE") else finite(light.size)
-        spread = getattr(light, "spread", math.pi)
-        if spread < math.pi - 1e-4 and warnings is not None:
-            warnings.append("light '%s': area light spread is ignored" % obj.name)
+        ext["spread"] = finite(getattr(light, "spread", math.pi), math.pi)
     if not compat.light_normalized(light) and t != "SUN":
         # Cycles then keeps the radiance of a 1 m^2 (or 1 m radius disc) emitter:
         # the same picture as a normalized light of power * area.
@@ -47,7 +47,13 @@ def convert_light(light, obj, matrix=None, warnings=None):
             ext["power"] *= area
         elif ext.get("radius", 0.0) > 0.0:
             ext["power"] *= math.pi * ext["radius"] ** 2
-    ext["visible_camera"] = compat.visible_camera(obj)
+    vis = compat.ray_visibility(obj)
+    ext["visible_camera"] = vis["camera"]
+    ext["visible_diffuse"] = vis["diffuse"]
+    ext["visible_glossy"] = vis["glossy"]
+    ext["visible_transmission"] = vis["transmission"]
+    ext["cast_shadow"] = bool(getattr(light, "use_shadow", True))
+    ext["multiple_importance"] = compat.light_uses_mis(light)
 
     # A KHR_lights_punctual copy for other tools (Blender exporter's 'SPEC' units).
     khr = None

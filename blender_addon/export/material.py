@@ -261,7 +261,20 @@ class MaterialGraph:
         if self._root(out, "Volume") is not None:
             self.report(self.name, out, "volume shaders are not supported; the Volume input is "
                         "ignored")
+        self._mark_alpha_links(graph)
         return graph
+
+    def _mark_alpha_links(self, graph):
+        """props.alpha_linked of every Image Texture: whether its Alpha output is used (Cycles
+        then un-premultiplies the Color output; the graph holds only nodes the output reaches)."""
+        used = {tuple(graph[k]) for k in ("surface", "displacement") if graph.get(k)}
+        for entry in self.nodes:
+            for v in entry["inputs"].values():
+                if isinstance(v, dict) and "link" in v:
+                    used.add(tuple(v["link"]))
+        for i, entry in enumerate(self.nodes):
+            if entry["type"] == "ShaderNodeTexImage":
+                entry["props"]["alpha_linked"] = (i, "Alpha") in used
 
     # -- resolution ----------------------------------------------------------------------------
 
@@ -485,9 +498,11 @@ class MaterialGraph:
         if idx is not None:  # how the pixels as written are to be read (see TESELA_images)
             entry = self.images.images[idx]
             props["colorspace"] = entry["colorspace"]
+            props["source_colorspace"] = entry["source_colorspace"]
             props["alpha_mode"] = entry["alpha_mode"]
         else:
             props["colorspace"] = image.colorspace_settings.name
+            props["source_colorspace"] = image.colorspace_settings.name
             props["alpha_mode"] = getattr(image, "alpha_mode", "STRAIGHT")
 
     def _props_texcoord(self, node, props):

@@ -6,9 +6,14 @@
 //! at `ref_p`** (zero for delta lights, which only `sample` can reach).
 
 pub mod area;
+pub mod area_light;
 pub mod background;
 pub mod directional;
+pub mod environment;
+pub mod light_bvh;
+pub mod light_tree;
 pub mod point;
+pub mod sphere;
 pub mod spot;
 
 use crate::sampling::DiscreteCdf;
@@ -16,9 +21,12 @@ use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 
 pub use area::AreaEmitter;
+pub use area_light::AreaLight;
 pub use background::Background;
 pub use directional::Directional;
+pub use environment::Environment;
 pub use point::PointLight;
+pub use sphere::SphereLight;
 pub use spot::SpotLight;
 
 /// An emitter query (nori's `EmitterQueryRecord`).
@@ -107,6 +115,12 @@ pub enum EmitterInstance {
     Spot(SpotLight),
     Directional(Directional),
     Background(Background),
+    /// A world that varies with direction (a node graph).
+    Environment(Environment),
+    /// A point or spot light with a radius.
+    Sphere(SphereLight),
+    /// A Blender area light.
+    AreaLight(AreaLight),
 }
 
 macro_rules! dispatch {
@@ -117,6 +131,9 @@ macro_rules! dispatch {
             EmitterInstance::Spot($e) => $body,
             EmitterInstance::Directional($e) => $body,
             EmitterInstance::Background($e) => $body,
+            EmitterInstance::Environment($e) => $body,
+            EmitterInstance::Sphere($e) => $body,
+            EmitterInstance::AreaLight($e) => $body,
         }
     };
 }
@@ -152,24 +169,47 @@ pub fn luminance(c: Vec3) -> f32 {
 /// How the integrators choose one light for a shadow ray.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum LightChoice {
-    /// Probability proportional to each emitter's power.
+    /// Proportional to each emitter's power; in scenes with at least [`TREE_MIN_LIGHTS`]
+    /// lights at finite positions, through a light tree that also weighs their distance and
+    /// orientation at each shading point.
     #[default]
     Power,
+    /// Proportional to power, never through a light tree.
+    Flat,
     /// The seed's uniform choice (every emitter with positive power equally likely).
     Uniform,
 }
 
-/// A discrete distribution over the scene's emitters.
+/// With this many lights at finite positions or more, [`LightChoice::Power`] uses a light tree.
+pub const TREE_MIN_LIGHTS: usize = 8;
+
+/// A discrete distribution over the scene's emitters, possibly depending on the shading point.
 #[derive(Clone, Debug, Default)]
 pub struct LightSampler {
     cdf: DiscreteCdf,
+    tree: Option<TreeChoice>,
+}
+
+/// Lights at finite positions in a light tree; the others (at infinity) chosen by power, against
+/// the tree as a whole by its total power.
+#[derive(Clone, Debug)]
+struct TreeChoice {
+    tree: light_tree::LightTree,
+    /// Tree item → emitter, and emitter → tree item (`u32::MAX`: not in the tree).
+    emitter_of: Vec<u32>,
+    item_of: Vec<u32>,
+    /// Entries: the emitters at infinity, then the tree.
+    top: DiscreteCdf,
+    /// Top entry → emitter (`u32::MAX` for the tree), and emitter → top entry.
+    top_emitter: Vec<u32>,
+    top_of: Vec<u32>,
 }
 
 impl LightSampler {
     /// Builds the distribution; emitters with zero power are never chosen.
     pub fn new(powers: &[f32], choice: LightChoice) -> Self {
         let weights = powers.iter().map(|&p| match choice {
-            LightChoice::Power => p,
+            LightChoice::Power | LightChoice::Flat => p,
             LightChoice::Uniform => {
                 if p > 0.0 && p.is_finite() {
                     1.0
@@ -180,20 +220,82 @@ impl LightSampler {
         });
         LightSampler {
             cdf: DiscreteCdf::new(weights),
+            tree: None,
         }
+    }
+
+    /// Builds the distribution for `choice`, with a light tree over the emitters that have
+    /// `bounds` (their `phi` their power) when `choice` is [`LightChoice::Power`] and there are
+    /// enough of them.
+    pub fn with_bounds(
+        powers: &[f32],
+        bounds: &[Option<light_tree::LightBounds>],
+        choice: LightChoice,
+    ) -> Self {
+        let mut flat = LightSampler::new(powers, choice);
+        let usable = |p: f32| p > 0.0 && p.is_finite();
+        let finite = bounds
+            .iter()
+            .zip(powers)
+            .filter(|(b, p)| b.is_some() && usable(**p))
+            .count();
+        if choice != LightChoice::Power || finite < TREE_MIN_LIGHTS || flat.cdf.is_empty() {
+            return flat;
+        }
+        let mut items = Vec::new();
+        let mut emitter_of = Vec::new();
+        let mut item_of = vec![u32::MAX; powers.len()];
+        let mut top_weights = Vec::new();
+        let mut top_emitter = Vec::new();
+        let mut top_of = vec![u32::MAX; powers.len()];
+        let mut tree_power = 0.0f64;
+        for (i, (b, &p)) in bounds.iter().zip(powers).enumerate() {
+            if !usable(p) {
+                continue;
+            }
+            match b {
+                Some(b) => {
+                    item_of[i] = items.len() as u32;
+                    emitter_of.push(i as u32);
+                    items.push(light_tree::LightBounds { phi: p, ..*b });
+                    tree_power += p as f64;
+                }
+                None => {
+                    top_of[i] = top_weights.len() as u32;
+                    top_weights.push(p);
+                    top_emitter.push(i as u32);
+                }
+            }
+        }
+        top_weights.push(tree_power as f32);
+        top_emitter.push(u32::MAX);
+        flat.tree = Some(TreeChoice {
+            tree: light_tree::LightTree::new(&items),
+            emitter_of,
+            item_of,
+            top: DiscreteCdf::new(top_weights),
+            top_emitter,
+            top_of,
+        });
+        flat
     }
 
     pub fn is_empty(&self) -> bool {
         self.cdf.is_empty()
     }
 
-    /// `(emitter index, probability)`; `u` is rescaled for reuse.
+    /// Whether the choice depends on the shading point (a light tree).
+    pub fn uses_tree(&self) -> bool {
+        self.tree.is_some()
+    }
+
+    /// `(emitter index, probability)`; `u` is rescaled for reuse. Ignores a light tree.
     #[inline]
     pub fn sample(&self, u: f32) -> (usize, f32) {
         self.cdf.sample(u)
     }
 
-    /// Probability of choosing emitter `i`.
+    /// Probability of choosing emitter `i`, ignoring a light tree.
     #[inline]
     pub fn pmf(&self, i: usize) -> f32 {
         if self.cdf.is_empty() {
@@ -201,5 +303,40 @@ impl LightSampler {
         } else {
             self.cdf.pmf(i)
         }
+    }
+
+    /// Chooses an emitter for a shading point at `p`: `(emitter index, probability)`, or
+    /// `None` when there is none (or none can reach `p`).
+    #[inline]
+    pub fn sample_at(&self, p: Vec3, u: f32) -> Option<(usize, f32)> {
+        if self.cdf.is_empty() {
+            return None;
+        }
+        let Some(t) = &self.tree else {
+            return Some(self.cdf.sample(u));
+        };
+        let (k, u) = t.top.sample_reuse(u);
+        let pk = t.top.pmf(k);
+        let e = t.top_emitter[k];
+        if e != u32::MAX {
+            return Some((e as usize, pk));
+        }
+        let (item, pmf) = t.tree.sample(p, u)?;
+        Some((t.emitter_of[item] as usize, pk * pmf))
+    }
+
+    /// The probability that [`LightSampler::sample_at`] chooses emitter `i` at `p`.
+    #[inline]
+    pub fn pmf_at(&self, p: Vec3, i: usize) -> f32 {
+        let Some(t) = &self.tree else {
+            return self.pmf(i);
+        };
+        if t.top_of[i] != u32::MAX {
+            return t.top.pmf(t.top_of[i] as usize);
+        }
+        if t.item_of[i] == u32::MAX {
+            return 0.0;
+        }
+        t.top.pmf(t.top.len() - 1) * t.tree.pmf(p, t.item_of[i] as usize)
     }
 }

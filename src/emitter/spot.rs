@@ -15,6 +15,44 @@ pub struct SpotLight {
     pub falloff: SpotFalloff,
 }
 
+/// A spot's falloff factor for a direction at cosine `cos` from its axis.
+#[inline]
+pub fn spot_falloff(falloff: &SpotFalloff, cos: f32) -> f32 {
+    match *falloff {
+        SpotFalloff::Gltf {
+            cos_inner,
+            cos_outer,
+        } => {
+            if cos <= cos_outer {
+                0.0
+            } else if cos >= cos_inner || cos_inner <= cos_outer {
+                1.0
+            } else {
+                let t = (cos - cos_outer) / (cos_inner - cos_outer);
+                t * t
+            }
+        }
+        SpotFalloff::Cycles { cos_half, smooth } => {
+            if cos <= cos_half {
+                0.0
+            } else if smooth <= 0.0 {
+                1.0
+            } else {
+                smoothstep01((cos - cos_half) / smooth)
+            }
+        }
+    }
+}
+
+/// The cosine of a spot's outer half-angle: no light beyond it.
+#[inline]
+pub fn spot_cos_outer(falloff: &SpotFalloff) -> f32 {
+    match *falloff {
+        SpotFalloff::Gltf { cos_outer, .. } => cos_outer,
+        SpotFalloff::Cycles { cos_half, .. } => cos_half,
+    }
+}
+
 /// Hermite smoothstep on `[0, 1]`.
 #[inline]
 fn smoothstep01(x: f32) -> f32 {
@@ -26,37 +64,11 @@ impl SpotLight {
     /// Falloff factor for a direction at cosine `cos` from the axis.
     #[inline]
     pub fn falloff(&self, cos: f32) -> f32 {
-        match self.falloff {
-            SpotFalloff::Gltf {
-                cos_inner,
-                cos_outer,
-            } => {
-                if cos <= cos_outer {
-                    0.0
-                } else if cos >= cos_inner || cos_inner <= cos_outer {
-                    1.0
-                } else {
-                    let t = (cos - cos_outer) / (cos_inner - cos_outer);
-                    t * t
-                }
-            }
-            SpotFalloff::Cycles { cos_half, smooth } => {
-                if cos <= cos_half {
-                    0.0
-                } else if smooth <= 0.0 {
-                    1.0
-                } else {
-                    smoothstep01((cos - cos_half) / smooth)
-                }
-            }
-        }
+        spot_falloff(&self.falloff, cos)
     }
 
     fn cos_outer(&self) -> f32 {
-        match self.falloff {
-            SpotFalloff::Gltf { cos_outer, .. } => cos_outer,
-            SpotFalloff::Cycles { cos_half, .. } => cos_half,
-        }
+        spot_cos_outer(&self.falloff)
     }
 }
 

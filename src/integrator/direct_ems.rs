@@ -2,7 +2,7 @@
 //! surface, one light sample and a shadow ray. Emitters seen directly (or through a chain of
 //! delta bounces) show their radiance.
 
-use super::{Integrator, MAX_TRANSPARENT, ShadingPoint, sample_emitter, spawn, trace_emitted};
+use super::{Integrator, MAX_TRANSPARENT, ShadingPoint, sample_emitter, spawn, trace_lit};
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
 
@@ -17,9 +17,13 @@ impl Integrator for DirectEms {
         let mut depth = 1;
         let mut transparent = 0;
         loop {
-            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth, depth >= self.max_depth);
+            let last = depth >= self.max_depth;
+            let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
             if let Some((_, le, _)) = emitted {
                 l += throughput * le;
+            }
+            if lights != Vec3::ZERO {
+                l += throughput * lights;
             }
             let Some(its) = hit else {
                 return l;

@@ -1,7 +1,7 @@
 //! Direct illumination by BSDF sampling (the seed's `direct_mats`): one BSDF sample at the
 //! first non-delta surface; its ray counts the radiance of whatever emitter it hits.
 
-use super::{Integrator, MAX_TRANSPARENT, ShadingPoint, spawn, trace_emitted};
+use super::{Integrator, MAX_TRANSPARENT, ShadingPoint, spawn, trace_lit};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
@@ -17,9 +17,13 @@ impl Integrator for DirectMats {
         let mut depth = 1;
         let mut transparent = 0;
         loop {
-            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth, depth >= self.max_depth);
+            let last = depth >= self.max_depth;
+            let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
             if let Some((_, le, _)) = emitted {
                 l += throughput * le;
+            }
+            if lights != Vec3::ZERO {
+                l += throughput * lights;
             }
             let Some(its) = hit else {
                 return l;
@@ -50,8 +54,12 @@ impl Integrator for DirectMats {
             depth += 1;
             if rec.measure != Measure::Discrete {
                 // The one non-delta bounce: count what it sees, then stop.
-                if let (_, Some((_, le, _))) = trace_emitted(scene, ctx, o, d, depth, true) {
+                let (_, emitted, lights) = trace_lit(scene, ctx, o, d, depth, true, f32::INFINITY);
+                if let Some((_, le, _)) = emitted {
                     l += throughput * le;
+                }
+                if lights != Vec3::ZERO {
+                    l += throughput * lights;
                 }
                 return l;
             }

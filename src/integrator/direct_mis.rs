@@ -4,7 +4,7 @@
 //! produce them). The light-choice probability is part of the emitter density on both sides.
 
 use super::{
-    Integrator, MAX_TRANSPARENT, ShadingPoint, mis_weight, sample_emitter, spawn, trace_emitted,
+    Integrator, MAX_TRANSPARENT, ShadingPoint, mis_weight, sample_emitter, spawn, trace_lit,
 };
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
@@ -21,9 +21,13 @@ impl Integrator for DirectMis {
         let mut depth = 1;
         let mut transparent = 0;
         loop {
-            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth, depth >= self.max_depth);
+            let last = depth >= self.max_depth;
+            let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
             if let Some((_, le, _)) = emitted {
                 l += throughput * le;
+            }
+            if lights != Vec3::ZERO {
+                l += throughput * lights;
             }
             let Some(its) = hit else {
                 return l;
@@ -57,8 +61,12 @@ impl Integrator for DirectMis {
             depth += 1;
             if rec.measure != Measure::Discrete {
                 // The BSDF half of MIS at this vertex, then stop.
-                if let (_, Some((e, le, erec))) = trace_emitted(scene, ctx, o, d, depth, true) {
+                let (_, emitted, lights) = trace_lit(scene, ctx, o, d, depth, true, rec.pdf);
+                if let Some((e, le, erec)) = emitted {
                     l += throughput * le * mis_weight(rec.pdf, scene.light_pdf(e, &erec));
+                }
+                if lights != Vec3::ZERO {
+                    l += throughput * lights;
                 }
                 return l;
             }

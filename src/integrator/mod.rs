@@ -61,6 +61,9 @@ pub struct ShadingPoint {
     pub wi: Vec3,
     /// The chosen closure's weight divided by the probability of choosing it.
     pub weight: Vec3,
+    /// The interpolated normal on the viewer's side when the closure's own normal differs
+    /// from it (normal or bump map), for Cycles' bump shadowing; `None` otherwise.
+    smooth: Option<Vec3>,
 }
 
 impl ShadingPoint {
@@ -108,7 +111,15 @@ impl ShadingPoint {
             }
             None => Frame::from_normal(n),
         };
+        let smooth = (closure.normal != Vec3::ZERO).then(|| {
+            if its.ns.dot(-d) < 0.0 {
+                -its.ns
+            } else {
+                its.ns
+            }
+        });
         Some(ShadingPoint {
+            smooth,
             passes: matches!(
                 closure.kind,
                 crate::shading::ClosureKind::Transparent { .. }
@@ -118,6 +129,27 @@ impl ShadingPoint {
             frame,
             weight: closure.weight * inv_p,
         })
+    }
+
+    /// The kinds of scattering of the chosen BSDF (Light Path bits `DIFFUSE`, `GLOSSY`,
+    /// `TRANSMISSION`), for lights that exclude some of them. The glossy coat over a diffuse
+    /// base counts as both (one BSDF here; the light is excluded when it excludes both).
+    #[inline]
+    pub fn light_class(&self) -> u32 {
+        use crate::shading::globals::ray;
+        match self.bsdf {
+            BsdfInstance::Diffuse(_) => ray::DIFFUSE,
+            BsdfInstance::Mirror(_) | BsdfInstance::RoughConductor(_) => ray::GLOSSY,
+            BsdfInstance::Plastic(_) => ray::DIFFUSE | ray::GLOSSY,
+            BsdfInstance::Dielectric(_) | BsdfInstance::RoughDielectric(_) => {
+                ray::GLOSSY | ray::TRANSMISSION
+            }
+            // Cycles counts translucent among the diffuse closures (CLOSURE_IS_BSDF_DIFFUSE).
+            BsdfInstance::Translucent(_) => ray::DIFFUSE,
+            BsdfInstance::Transparent(_) => ray::TRANSMISSION,
+            BsdfInstance::Sheen(_) => ray::DIFFUSE,
+            BsdfInstance::Layered(_) => ray::DIFFUSE | ray::GLOSSY | ray::TRANSMISSION,
+        }
     }
 
     /// True when the chosen BSDF is purely specular.
@@ -134,7 +166,43 @@ impl ShadingPoint {
         if !self.bsdf.is_transmissive() && its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
             return Vec3::ZERO;
         }
-        self.bsdf.eval(&BsdfQueryRecord::pair(self.wi, lo)) * lo.z.abs() * self.weight
+        let f = self.bsdf.eval(&BsdfQueryRecord::pair(self.wi, lo)) * lo.z.abs() * self.weight;
+        match self.smooth {
+            Some(ns) => f * self.bump_shadowing(ns, wo, true),
+            None => f,
+        }
+    }
+
+    /// Cycles' correction for a closure normal that differs from the interpolated one `ns`
+    /// (normal and bump maps), for light leaving along world direction `wo`: zero where `wo`
+    /// lies on the wrong side of the interpolated surface for the closure's normal (for
+    /// evaluation, and for diffuse lobes always), and for diffuse lobes a GGX shadowing term
+    /// (Chiang et al. 2019) with `α² = tan²(N, Ns) / 8` that darkens the terminator smoothly.
+    fn bump_shadowing(&self, ns: Vec3, wo: Vec3, is_eval: bool) -> f32 {
+        let n = self.frame.n;
+        let (cos_nsi, cos_nsn, cos_ni) = (ns.dot(wo), ns.dot(n), n.dot(wo));
+        let diffuse = matches!(
+            self.bsdf,
+            BsdfInstance::Diffuse(_) | BsdfInstance::Translucent(_)
+        );
+        if cos_nsi * cos_nsn * cos_ni < 0.0 && (is_eval || diffuse) {
+            return 0.0;
+        }
+        if !diffuse {
+            return 1.0;
+        }
+        let (cos_i, cos_d) = (cos_nsi.abs(), cos_nsn.abs());
+        if cos_d >= 1.0 || cos_i >= 1.0 {
+            return 1.0;
+        }
+        if cos_i < 1e-6 {
+            return 0.0;
+        }
+        let tan2_d = 1.0 / (cos_d * cos_d) - 1.0;
+        let alpha2 = (0.125 * tan2_d).clamp(0.0, 1.0);
+        let tan2_i = 1.0 / (cos_i * cos_i) - 1.0;
+        let lambda = ((1.0 + alpha2 * tan2_i).sqrt() - 1.0) * 0.5;
+        1.0 / (1.0 + lambda)
     }
 
     /// Light Path bits of a ray sampled from this point.
@@ -182,6 +250,13 @@ impl ShadingPoint {
         let reflect = rec.wo.z * self.wi.z > 0.0;
         ctx.ray_flags = self.ray_flags(&rec, reflect);
         if reflect && its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
+            return None;
+        }
+        let w = match self.smooth {
+            Some(ns) => w * self.bump_shadowing(ns, wo, false),
+            None => w,
+        };
+        if w == Vec3::ZERO {
             return None;
         }
         Some((wo, w, rec))
@@ -250,18 +325,22 @@ pub fn sample_emitter(
     let uc = ctx.sampler.next_1d();
     let u = ctx.sampler.next_2d();
     let (light, rec, weight) = scene.sample_light(its.p, uc, u);
-    if weight == Vec3::ZERO {
+    if weight == Vec3::ZERO || !scene.light_reaches(light, sp.light_class()) {
         return Vec3::ZERO;
     }
     let f = sp.eval_cos(its, d, rec.wi);
     if f == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let tr = scene.transmittance(ctx, its.p, its.ng, &rec);
+    let tr = if scene.casts_shadow(light) {
+        scene.transmittance(ctx, its.p, its.ng, &rec)
+    } else {
+        Vec3::ONE
+    };
     if tr == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let w = if mis && !scene.is_delta_light(light) {
+    let w = if mis && scene.light_uses_mis(light) {
         mis_weight(rec.pdf, sp.pdf(rec.wi))
     } else {
         1.0
@@ -283,12 +362,48 @@ pub fn trace_emitted(
     depth: u32,
     last: bool,
 ) -> (Option<Intersection>, Emitted) {
+    ctx.depth = depth;
     if last && depth > 1 {
         return (None, scene.emission_along(ctx, o, d));
     }
     let hit = scene.trace(ctx, o, d, depth);
-    let emitted = scene.emission_at(hit.as_ref(), o, d);
+    let flags = if depth <= 1 {
+        crate::shading::globals::ray::CAMERA
+    } else {
+        ctx.ray_flags
+    };
+    let emitted = scene.emission_at(hit.as_ref(), o, d, depth, flags);
     (hit, emitted)
+}
+
+/// [`trace_emitted`], plus the radiance of the Blender lights' shapes the ray passes through
+/// before that surface (lights are not surfaces: they never stop a ray), weighted against
+/// emitter sampling with the density `bsdf_pdf` of the BSDF sample that made the ray
+/// (infinite: weight 1, for camera rays, delta bounces and integrators without emitter
+/// sampling). Zero in scenes without such lights.
+#[inline]
+pub fn trace_lit(
+    scene: &RenderScene,
+    ctx: &mut Ctx,
+    o: Vec3,
+    d: Vec3,
+    depth: u32,
+    last: bool,
+    bsdf_pdf: f32,
+) -> (Option<Intersection>, Emitted, Vec3) {
+    let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth, last);
+    if !scene.has_light_shapes() {
+        return (hit, emitted, Vec3::ZERO);
+    }
+    let lights = if last && depth > 1 {
+        scene.lights_on_ray(ctx, o, d, f32::INFINITY, depth, bsdf_pdf, true)
+    } else {
+        let tmax = hit
+            .as_ref()
+            .map_or(f32::INFINITY, |its| (its.p - o).length());
+        scene.lights_on_ray(ctx, o, d, tmax, depth, bsdf_pdf, false)
+    };
+    (hit, emitted, lights)
 }
 
 /// Origin for a ray leaving `its` along `wo`.

@@ -3,7 +3,7 @@
 //! throughput's **maximum** component, survival probability capped at 0.95.
 
 use super::{
-    Integrator, MAX_TRANSPARENT, ShadingPoint, mis_weight, sample_emitter, spawn, trace_emitted,
+    Integrator, MAX_TRANSPARENT, ShadingPoint, mis_weight, sample_emitter, spawn, trace_lit,
 };
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
@@ -41,9 +41,13 @@ impl Integrator for PathMats {
         let mut depth = 1;
         let mut transparent = 0;
         loop {
-            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth, depth >= self.max_depth);
+            let last = depth >= self.max_depth;
+            let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
             if let Some((_, le, _)) = emitted {
                 l += throughput * le;
+            }
+            if lights != Vec3::ZERO {
+                l += throughput * lights;
             }
             let Some(its) = hit else {
                 return l;
@@ -86,7 +90,8 @@ impl Integrator for PathMis {
         // and delta samples (emitter sampling could not have produced them: MIS weight 1).
         let mut bsdf_pdf = f32::INFINITY;
         loop {
-            let (hit, emitted) = trace_emitted(scene, ctx, o, d, depth, depth >= self.max_depth);
+            let last = depth >= self.max_depth;
+            let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, bsdf_pdf);
             if let Some((e, le, erec)) = emitted {
                 let w = if bsdf_pdf.is_infinite() {
                     1.0
@@ -94,6 +99,9 @@ impl Integrator for PathMis {
                     mis_weight(bsdf_pdf, scene.light_pdf(e, &erec))
                 };
                 l += throughput * le * w;
+            }
+            if lights != Vec3::ZERO {
+                l += throughput * lights;
             }
             let Some(its) = hit else {
                 return l;

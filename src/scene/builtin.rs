@@ -210,6 +210,7 @@ fn cornell_shell(scene: &mut Scene) {
         },
         to_world: Mat4::from_translation(v(0.0, 0.5, 1.94)),
         aspect: Some(1.0),
+        ..Default::default()
     });
 }
 
@@ -334,6 +335,7 @@ pub fn glass_pane() -> Scene {
         },
         to_world: look_at(v(0.0, 1.3, 2.6), v(0.0, 0.7, -0.5)),
         aspect: None,
+        ..Default::default()
     });
     scene
 }

@@ -1,9 +1,9 @@
 //! Writes a [`Scene`] as a self-contained glTF 2.0 file (one buffer as a base64 data URI).
 //! Used to turn the built-in scenes into `scenes/*.gltf`; textures are not written.
 
-use super::{Light, Projection, Scene, SpotFalloff};
+use super::{Light, Projection, Scene, SensorFit, SpotFalloff};
 use base64::Engine;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use serde_json::{Value, json};
 use std::path::Path;
 
@@ -190,6 +190,8 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), String> {
                     json!({"type": "directional", "color": c, "intensity": s * LUMENS_PER_WATT}),
                 )
             }
+            // Blender lights come from the add-on's files; the built-in scenes have none.
+            Light::Blender { .. } => continue,
         };
         lights.push(light);
         let mut node = node;
@@ -198,6 +200,19 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), String> {
     }
     let mut cameras = Vec::new();
     if let Some(c) = &scene.camera {
+        // Only what a glTF camera can say (the built-in scenes need no more).
+        let plain = c.fit == SensorFit::Vertical
+            && c.shift == Vec2::ZERO
+            && c.aperture.is_none()
+            && c.clip_start == 0.0
+            && c.clip_end == f32::INFINITY;
+        if !plain {
+            return Err(
+                "the camera's sensor fit, lens shift, clipping or depth of field cannot \
+                        be written as a glTF camera"
+                    .into(),
+            );
+        }
         cameras.push(match c.projection {
             Projection::Perspective { yfov } => {
                 let mut p = json!({"yfov": yfov, "znear": 0.01});
@@ -208,6 +223,9 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), String> {
             }
             Projection::Orthographic { ymag } => json!({"type": "orthographic",
                 "orthographic": {"xmag": ymag, "ymag": ymag, "znear": 0.01, "zfar": 1000.0}}),
+            Projection::Panoramic(_) => {
+                return Err("a panoramic camera cannot be written as a glTF camera".into());
+            }
         });
         let m: Vec<f32> = c.to_world.to_cols_array().to_vec();
         nodes.push(json!({"name": "camera", "camera": 0, "matrix": m}));

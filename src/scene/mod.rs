@@ -8,8 +8,10 @@ pub mod builtin;
 pub mod error;
 pub mod gltf;
 pub mod gltf_write;
+pub mod world;
 
 pub use error::{LoadError, LoadErrorKind};
+pub use world::{World, WorldSampling};
 
 use glam::{Mat4, Vec2, Vec3};
 use std::sync::Arc;
@@ -65,12 +67,16 @@ pub struct MeshAttributes {
     /// Names of the UV sets: `uv_names[0]` names [`Mesh::uvs`], `uv_names[k]` names
     /// `extra_uvs[k - 1]` (may be shorter than the sets: unnamed).
     pub uv_names: Vec<String>,
-    /// UV sets 1, 2, ... (glTF convention: `(0, 0)` is the image's top-left corner).
+    /// UV sets 1, 2, ... (glTF convention: `(0, 0)` is the image's top-left corner); a set
+    /// the file lacks, or that nothing reads, is empty.
     pub extra_uvs: Vec<Vec<Vec2>>,
     /// Vertex colours (linear RGBA), with their names.
     pub colors: Vec<(String, Vec<glam::Vec4>)>,
-    /// Per-vertex tangents, world space: `xyz` unit tangent along +u, `w` the bitangent sign
-    /// (MikkTSpace, for UV set 0). Empty when the mesh has none.
+    /// Per-vertex tangents, world space: `xyz` unit tangent along +u, `w` the bitangent sign:
+    /// the bitangent `w · cross(normal, tangent)` points along +v in Blender's UV convention
+    /// (towards the image's top row, glTF's "+Y up" of normal maps). For the UV set of the
+    /// material's normal map (set 0 unless its `texCoord` says otherwise): the file's TANGENT,
+    /// else MikkTSpace. Empty when the mesh has none.
     pub tangents: Vec<glam::Vec4>,
     /// World → object space (the space of the node's mesh data).
     pub to_object: Mat4,
@@ -126,16 +132,13 @@ impl Mesh {
         (l > 1e-12 && l.is_finite()).then(|| s / l)
     }
 
-    /// UV set `set` (glTF convention), zero where the mesh has none.
+    /// UV set `set` (glTF convention): set 0 where the mesh lacks set `set` (the loader warns
+    /// when a material reads a set its mesh does not have), zero where it has no UVs at all.
     #[inline]
     pub fn uv(&self, set: usize, tri: u32, b1: f32, b2: f32) -> Vec2 {
-        let data = if set == 0 {
-            &self.uvs[..]
-        } else {
-            self.attrs
-                .extra_uvs
-                .get(set - 1)
-                .map_or(&[][..], |v| &v[..])
+        let data = match set.checked_sub(1).and_then(|k| self.attrs.extra_uvs.get(k)) {
+            Some(v) if !v.is_empty() => &v[..],
+            _ => &self.uvs[..],
         };
         self.interpolate(data, tri, b1, b2).unwrap_or(Vec2::ZERO)
     }
@@ -180,12 +183,108 @@ pub struct Texture {
 }
 
 /// A material's reference to a texture.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TexRef {
     /// Index into [`Scene::textures`].
     pub texture: usize,
-    /// Which TEXCOORD set (only 0 is loaded; others fall back to 0).
+    /// Which TEXCOORD set (after `KHR_texture_transform`'s `texCoord` override).
     pub texcoord: u32,
+    /// `KHR_texture_transform`, applied to the texture coordinate before the lookup.
+    pub transform: Option<UvTransform>,
+}
+
+/// `KHR_texture_transform`: `uv' = T(offset) · R(rotation) · S(scale) · uv` in glTF's UV
+/// convention (`(0, 0)` top-left), with the extension's rotation matrix
+/// `[cos, sin; -sin, cos]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvTransform {
+    pub offset: Vec2,
+    pub rotation: f32,
+    pub scale: Vec2,
+}
+
+impl UvTransform {
+    /// The 2×3 matrix, row-major: `u' = m[0] u + m[1] v + m[2]`, `v' = m[3] u + m[4] v + m[5]`.
+    pub fn matrix(&self) -> [f32; 6] {
+        let (s, c) = self.rotation.sin_cos();
+        let (sx, sy) = (self.scale.x, self.scale.y);
+        [
+            c * sx,
+            s * sy,
+            self.offset.x,
+            -s * sx,
+            c * sy,
+            self.offset.y,
+        ]
+    }
+
+    /// `uv'` for `uv`.
+    pub fn apply(&self, uv: Vec2) -> Vec2 {
+        let m = self.matrix();
+        Vec2::new(
+            m[0] * uv.x + m[1] * uv.y + m[2],
+            m[3] * uv.x + m[4] * uv.y + m[5],
+        )
+    }
+}
+
+/// glTF `alphaMode`: how the base colour's alpha becomes coverage (the Principled `Alpha`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum AlphaMode {
+    /// Alpha is ignored: fully opaque.
+    #[default]
+    Opaque,
+    /// Alpha `>= cutoff` is opaque, below it fully transparent (exactly 1 or 0).
+    Mask { cutoff: f32 },
+    /// Alpha is partial coverage.
+    Blend,
+}
+
+/// `KHR_materials_clearcoat` (Principled coat inputs; coat IOR 1.5 as the extension fixes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Clearcoat {
+    pub factor: f32,
+    /// Linear; R times `factor`.
+    pub texture: Option<TexRef>,
+    pub roughness: f32,
+    /// Linear; G times `roughness`.
+    pub roughness_texture: Option<TexRef>,
+    /// Tangent-space normal map of the coat, with its `scale`.
+    pub normal_texture: Option<TexRef>,
+    pub normal_scale: f32,
+}
+
+/// `KHR_materials_sheen` (Principled sheen: weight 1, tint = sheen colour).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sheen {
+    pub color: Vec3,
+    /// sRGB; RGB times `color`.
+    pub color_texture: Option<TexRef>,
+    pub roughness: f32,
+    /// Linear; A times `roughness`.
+    pub roughness_texture: Option<TexRef>,
+}
+
+/// `KHR_materials_anisotropy` (Principled anisotropic inputs and tangent).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Anisotropy {
+    /// In `[0, 1]`.
+    pub strength: f32,
+    /// Radians, counter-clockwise from the tangent towards the bitangent.
+    pub rotation: f32,
+    /// Linear: RG the direction in tangent space (`2c - 1`), B times `strength`.
+    pub texture: Option<TexRef>,
+}
+
+/// `KHR_materials_volume`, kept for the record: the renderer refracts through transmissive
+/// meshes as solids whatever the thickness, and does not render attenuation yet.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Volume {
+    /// 0 = thin-walled.
+    pub thickness: f32,
+    pub attenuation_color: Vec3,
+    /// Metres; infinite = no attenuation.
+    pub attenuation_distance: f32,
 }
 
 /// glTF metallic-roughness material with the KHR extensions Tesela understands.
@@ -217,6 +316,24 @@ pub struct Material {
     pub specular_color: Vec3,
     /// glTF `doubleSided`.
     pub double_sided: bool,
+    /// Base colour factor alpha.
+    pub alpha: f32,
+    pub alpha_mode: AlphaMode,
+    /// The mesh's COLOR_0 (the first colour set) multiplies the base colour and alpha (set by
+    /// the loader on the variant of a glTF material used by primitives with COLOR_0).
+    pub vertex_color: bool,
+    /// Tangent-space normal map (linear), with glTF's `scale` on its X and Y.
+    pub normal_texture: Option<TexRef>,
+    pub normal_scale: f32,
+    /// `KHR_materials_transmission` texture: R times `transmission`.
+    pub transmission_texture: Option<TexRef>,
+    /// `KHR_materials_specular` textures: A times `specular`; sRGB RGB times `specular_color`.
+    pub specular_texture: Option<TexRef>,
+    pub specular_color_texture: Option<TexRef>,
+    pub clearcoat: Option<Clearcoat>,
+    pub sheen: Option<Sheen>,
+    pub anisotropy: Option<Anisotropy>,
+    pub volume: Option<Volume>,
     /// The material's node graph (`TESELA_material_graph`); without one, the renderer shades
     /// with the glTF metallic-roughness preset graph built from the factors above.
     pub graph: Option<Arc<crate::shading::Graph>>,
@@ -240,6 +357,18 @@ impl Default for Material {
             specular: 1.0,
             specular_color: Vec3::ONE,
             double_sided: false,
+            alpha: 1.0,
+            alpha_mode: AlphaMode::Opaque,
+            vertex_color: false,
+            normal_texture: None,
+            normal_scale: 1.0,
+            transmission_texture: None,
+            specular_texture: None,
+            specular_color_texture: None,
+            clearcoat: None,
+            sheen: None,
+            anisotropy: None,
+            volume: None,
             graph: None,
         }
     }
@@ -326,15 +455,182 @@ pub enum Light {
         irradiance: Vec3,
         angle: f32,
     },
+    /// A Blender light (`TESELA_light`): its shape with Cycles' parameters, and which rays see it.
+    Blender {
+        shape: LightShape,
+        visibility: LightVisibility,
+    },
 }
 
-/// Camera projection.
+/// The shape of a Blender light, with the parameters Cycles renders it from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightShape {
+    /// Point or spot light of radiant intensity `intensity` (W/sr). `radius` 0 is a delta light;
+    /// otherwise Cycles' shapes of radiance `intensity / (π radius²)`: a sphere, or with
+    /// `soft_falloff` (Blender's default) a disk of that radius always facing the lit point.
+    Point {
+        position: Vec3,
+        intensity: Vec3,
+        radius: f32,
+        soft_falloff: bool,
+        /// A spot's axis (unit, pointing away from the light) and falloff.
+        spot: Option<(Vec3, SpotFalloff)>,
+    },
+    /// Sun: light travels along `direction` (unit); `irradiance` (W/m²) on a surface facing it,
+    /// from a cone of directions of angular diameter `angle` (radians, 0 = delta).
+    Sun {
+        direction: Vec3,
+        irradiance: Vec3,
+        angle: f32,
+    },
+    /// Rectangle (`ellipse` false) or ellipse centred on `center`, spanned by the orthonormal
+    /// `axis_u`, `axis_v` over `size_u × size_v` metres, emitting radiance `radiance` towards
+    /// the side of the unit `normal` only, collimated by `spread` (radians, full angle; π = a
+    /// Lambertian emitter, 0 = a parallel beam along the normal).
+    Area {
+        center: Vec3,
+        axis_u: Vec3,
+        axis_v: Vec3,
+        normal: Vec3,
+        size_u: f32,
+        size_v: f32,
+        ellipse: bool,
+        radiance: Vec3,
+        spread: f32,
+    },
+}
+
+/// Which rays see a Blender light (Blender's Object > Visibility > Ray Visibility and the
+/// light's own settings, as Cycles applies them). A Blender light is never an occluder.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LightVisibility {
+    /// Camera rays see the light's shape.
+    pub camera: bool,
+    /// The light reaches diffuse / glossy (reflection) / transmission closures, by emitter
+    /// sampling and by rays those closures scatter.
+    pub diffuse: bool,
+    pub glossy: bool,
+    pub transmission: bool,
+    /// Shadow rays test occlusion ("Cast Shadow"); without, the light reaches every point it
+    /// faces.
+    pub cast_shadow: bool,
+    /// Rays scattered by surfaces hit the light's shape, weighted against emitter sampling
+    /// (Cycles' "Multiple Importance"); without, only emitter sampling reaches it.
+    pub mis: bool,
+}
+
+impl Default for LightVisibility {
+    fn default() -> Self {
+        LightVisibility {
+            camera: true,
+            diffuse: true,
+            glossy: true,
+            transmission: true,
+            cast_shadow: true,
+            mis: true,
+        }
+    }
+}
+
+/// Camera projection. Camera space: looking down -Z, +Y up, +X right (glTF; the same axes as a
+/// Blender camera object's local space).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Projection {
-    /// Vertical field of view in radians.
+    /// Pinhole or thin lens. `yfov` is the full angle, in radians, that the image dimension
+    /// chosen by [`Camera::fit`] spans: the height for glTF cameras ([`SensorFit::Vertical`]);
+    /// for a Blender camera `2 atan(sensor / (2 lens))`.
     Perspective { yfov: f32 },
-    /// Half-height of the view volume in metres.
+    /// Parallel projection. `ymag` is half the extent, in metres, of the image dimension chosen
+    /// by [`Camera::fit`] (glTF `ymag`; Blender `ortho_scale / 2`).
     Orthographic { ymag: f32 },
+    /// A panoramic camera (Blender/Cycles `PANO`).
+    Panoramic(Panorama),
+}
+
+/// Which image dimension a camera's field of view (or orthographic extent) spans, Blender's
+/// `sensor_fit`; the other dimension follows from the image aspect ratio.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SensorFit {
+    /// The width if the image is wider than tall, else the height (Blender's AUTO).
+    Auto,
+    Horizontal,
+    /// The height (glTF).
+    #[default]
+    Vertical,
+}
+
+impl SensorFit {
+    /// Whether the fitted dimension is the width of a `width × height` image.
+    #[inline]
+    pub fn is_horizontal(self, width: u32, height: u32) -> bool {
+        match self {
+            SensorFit::Auto => width > height,
+            SensorFit::Horizontal => true,
+            SensorFit::Vertical => false,
+        }
+    }
+}
+
+/// Panoramic projections as Cycles defines them. Image coordinates `(u, v)` run over
+/// `[0, 1]²` from the bottom-left corner (plus the lens shift); directions are given in
+/// Cycles' panorama space (+X the view axis, +Y left, +Z up), which is camera space
+/// `(-y, z, -x)`. Angles in radians, lengths in millimetres.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Panorama {
+    /// Longitude `lon_min + u (lon_max - lon_min)` (positive to the right), latitude
+    /// `lat_min + v (lat_max - lat_min)` (positive up).
+    Equirectangular {
+        latitude_min: f32,
+        latitude_max: f32,
+        longitude_min: f32,
+        longitude_max: f32,
+    },
+    /// Angle from the view axis `θ = r · fov / 2`, `r` the distance from the image centre in
+    /// units of the half width and half height (an ellipse on a non-square image); black
+    /// outside `r = 1`.
+    FisheyeEquidistant { fov: f32 },
+    /// `r = 2 lens sin(θ / 2)` on a sensor of `sensor` mm across the fitted dimension
+    /// ([`Camera::fit`]; Blender: `sensor_width`, or `sensor_height` for VERTICAL); black
+    /// beyond `θ = fov / 2`.
+    FisheyeEquisolid { fov: f32, lens: f32, sensor: f32 },
+    /// `θ = -(k0 + k1 r + k2 r² + k3 r³ + k4 r⁴)`, `r` in mm on the sensor as for
+    /// [`Panorama::FisheyeEquisolid`]; black beyond `|θ| = fov / 2`.
+    FisheyeLensPolynomial { fov: f32, sensor: f32, k: [f32; 5] },
+    /// A mirror ball filling the image's inscribed ellipse (Cycles' `mirrorball_to_direction`,
+    /// in its mirror-ball space: `(x, y, z)` is camera space `(x, z, y)`); black outside it.
+    Mirrorball,
+    /// One face of an equiangular cube map (90° across each axis).
+    EquiangularCubemapFace,
+    /// Azimuth `-(u_min + u (u_max - u_min))` around the up axis, height
+    /// `v_min + v (v_max - v_min)` on a cylinder of radius 1 (Blender's ranges divided by its
+    /// radius).
+    CentralCylindrical {
+        u_min: f32,
+        u_max: f32,
+        v_min: f32,
+        v_max: f32,
+    },
+}
+
+/// A thin lens (depth of field), sampled as Cycles samples it: a point `a` on the unit disk
+/// (concentric map) or on the regular polygon of `blades ≥ 3` corners inscribed in the unit
+/// circle, rotated by `rotation`, then `a.x /= ratio`; the ray leaves the lens at
+/// `radius · a` (camera space, on the lens plane z = 0) towards the point where the pinhole
+/// ray of the pixel meets the plane in focus.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aperture {
+    /// Lens radius in metres (Blender: `lens · 1e-3 / (2 f-stop)`; orthographic cameras
+    /// `1 / (2 f-stop)`, as Cycles does).
+    pub radius: f32,
+    /// Metres from the lens to the plane in focus along the view axis (perspective and
+    /// orthographic), or to the sphere in focus (panoramic).
+    pub focus_distance: f32,
+    /// 0 = a round aperture; otherwise at least 3.
+    pub blades: u32,
+    /// Rotation of the polygon, radians, counter-clockwise seen from behind the camera.
+    pub rotation: f32,
+    /// Anamorphic ratio: the aperture's horizontal size is divided by it (`> 0`).
+    pub ratio: f32,
 }
 
 /// A camera looking down its local -Z with +Y up (glTF convention).
@@ -345,6 +641,37 @@ pub struct Camera {
     pub to_world: Mat4,
     /// The file's aspect ratio (width/height), if it states one.
     pub aspect: Option<f32>,
+    /// The image dimension `projection`'s extent spans.
+    pub fit: SensorFit,
+    /// Lens shift (Blender `shift_x`, `shift_y`): the image window moves right and up by these
+    /// fractions of the fitted dimension's extent (panoramic cameras: `u` and `v` move by them).
+    pub shift: Vec2,
+    /// Clip distances in metres along the view axis, as Cycles applies them: a camera ray
+    /// starts where the pinhole ray of its pixel crosses the plane `z = -clip_start` (at
+    /// `clip_start` along the ray for panoramic cameras) and ends at `clip_end` the same way.
+    /// 0 and infinity for glTF cameras (their `znear`/`zfar` are not applied).
+    pub clip_start: f32,
+    pub clip_end: f32,
+    /// Depth of field; `None` = a pinhole.
+    pub aperture: Option<Aperture>,
+}
+
+impl Default for Camera {
+    /// A 40° pinhole at the origin (vertical fit, no shift, no clipping).
+    fn default() -> Self {
+        Camera {
+            projection: Projection::Perspective {
+                yfov: 40f32.to_radians(),
+            },
+            to_world: Mat4::IDENTITY,
+            aspect: None,
+            fit: SensorFit::Vertical,
+            shift: Vec2::ZERO,
+            clip_start: 0.0,
+            clip_end: f32::INFINITY,
+            aperture: None,
+        }
+    }
 }
 
 /// Render settings a scene file may carry (the add-on's `TESELA_render` extension).
@@ -357,6 +684,9 @@ pub struct RenderSettings {
     pub max_depth: Option<u32>,
     pub seed: Option<u64>,
     pub integrator: Option<String>,
+    /// Blender's `render.film_transparent`: camera rays that see only the world give alpha 0
+    /// (and no colour).
+    pub film_transparent: bool,
 }
 
 /// A complete scene.
@@ -370,6 +700,8 @@ pub struct Scene {
     pub camera: Option<Camera>,
     /// Constant background radiance seen by rays that leave the scene, W/(m² sr).
     pub background: Vec3,
+    /// The world's node graph and settings (the constant `background` is its fallback).
+    pub world: World,
     pub settings: RenderSettings,
     /// Non-fatal problems found while loading (unknown optional extensions, skipped primitives...).
     pub warnings: Vec<String>,

@@ -53,6 +53,7 @@ pub enum Op {
     Texture(nodes::texture::TextureOp),
     Utility(nodes::utility::UtilityOp),
     Bump(nodes::bump::BumpOp),
+    Environment(nodes::environment::EnvironmentOp),
 }
 
 impl Op {
@@ -67,6 +68,7 @@ impl Op {
             Op::Texture(op) => op.eval(s),
             Op::Utility(op) => op.eval(s),
             Op::Bump(op) => op.eval(s, g),
+            Op::Environment(op) => op.eval(s, env),
         }
     }
 }

@@ -1,60 +1,16 @@
-//! Lights: `KHR_lights_punctual` and Tesela's `TESELA_light` (including area lights,
-//! which become one-sided emissive meshes).
+//! Lights: `KHR_lights_punctual` and Tesela's `TESELA_light` (Blender's lights with their
+//! native parameters: radius, spot, sun angle, area shape and spread, ray visibility).
 
 use std::f32::consts::{FRAC_PI_4, PI};
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat4, Vec3};
 use serde_json::Value;
 
-use super::{LoadError, LoadErrorKind, Loader, LocalPrim, extension, invalid, member, num, rgb};
-use crate::scene::{Light, Material, Mesh, SpotFalloff};
+use super::{LoadError, Loader, extension, invalid, member, num, rgb};
+use crate::scene::{Light, LightShape, LightVisibility, SpotFalloff};
 
 /// Lumens per watt used to turn glTF's photometric units into radiometric ones.
 pub(crate) const LM_PER_W: f32 = 683.0;
-
-/// Segments of the fan used for disk and ellipse area lights.
-pub(crate) const DISK_SEGMENTS: u32 = 64;
-
-/// An area light's outline in its local XY plane, triangulated to face -Z.
-pub(crate) fn area_light_prim(shape: &str, sx: f32, sy: f32) -> LocalPrim {
-    let (hx, hy) = (0.5 * sx, 0.5 * sy);
-    let (positions, tris) = if matches!(shape, "DISK" | "ELLIPSE") {
-        let mut p = vec![Vec3::ZERO];
-        for k in 0..DISK_SEGMENTS {
-            let a = 2.0 * PI * k as f32 / DISK_SEGMENTS as f32;
-            p.push(Vec3::new(hx * a.cos(), hy * a.sin(), 0.0));
-        }
-        // The ring runs counter-clockwise seen from +Z; (centre, next, current) faces -Z.
-        let t = (1..=DISK_SEGMENTS)
-            .map(|k| [0, k % DISK_SEGMENTS + 1, k])
-            .collect();
-        (p, t)
-    } else {
-        let p = vec![
-            Vec3::new(-hx, -hy, 0.0),
-            Vec3::new(hx, -hy, 0.0),
-            Vec3::new(hx, hy, 0.0),
-            Vec3::new(-hx, hy, 0.0),
-        ];
-        (p, vec![[0, 2, 1], [0, 3, 2]])
-    };
-    LocalPrim {
-        positions,
-        normals: Vec::new(),
-        uvs: Vec::<Vec2>::new(),
-        tris,
-    }
-}
-
-/// Total area of a triangle mesh.
-pub(crate) fn mesh_area(p: &[Vec3], tris: &[[u32; 3]]) -> f32 {
-    tris.iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| p[i as usize]);
-            0.5 * (b - a).cross(c - a).length()
-        })
-        .sum()
-}
 
 fn valid_color(c: Vec3) -> bool {
     c.is_finite() && c.min_element() >= 0.0
@@ -163,6 +119,15 @@ impl<'a> Loader<'a> {
         let ty = member(t, "type").and_then(Value::as_str).unwrap_or("");
         let color = rgb(t, "color").unwrap_or(Vec3::ONE);
         let f = |k: &str, d: f32| num(t, k).map(|v| v as f32).unwrap_or(d);
+        let flag = |k: &str| member(t, k).and_then(Value::as_bool).unwrap_or(true);
+        let visibility = LightVisibility {
+            camera: flag("visible_camera"),
+            diffuse: flag("visible_diffuse"),
+            glossy: flag("visible_glossy"),
+            transmission: flag("visible_transmission"),
+            cast_shadow: flag("cast_shadow"),
+            mis: flag("multiple_importance"),
+        };
         let power = f("power", 0.0);
         let position = world.transform_point3(Vec3::ZERO);
         let direction = world.transform_vector3(-Vec3::Z).try_normalize();
@@ -170,55 +135,77 @@ impl<'a> Loader<'a> {
             me.warn_once(format!("node {ni}: TESELA_light {ty}: {why} (skipped)"));
             Ok(())
         };
-        match ty {
+        let shape = match ty {
             "POINT" | "SPOT" => {
                 let intensity = color * power / (4.0 * PI);
                 if !valid_color(intensity) {
                     return skip(self, "invalid color or power");
                 }
-                if ty == "POINT" {
-                    self.scene.lights.push(Light::Point {
-                        position,
-                        intensity,
-                    });
-                    return Ok(());
+                let mut radius = f("radius", 0.0);
+                if !(radius.is_finite() && radius >= 0.0) {
+                    self.warn_once(format!(
+                        "node {ni}: TESELA_light {ty}: radius {radius} is not a length; \
+                         rendered as radius 0"
+                    ));
+                    radius = 0.0;
                 }
-                let Some(direction) = direction else {
-                    return skip(self, "degenerate direction");
+                let spot = if ty == "SPOT" {
+                    let Some(direction) = direction else {
+                        return skip(self, "degenerate direction");
+                    };
+                    let size = f("spot_size", FRAC_PI_4);
+                    let blend = f("spot_blend", 0.15);
+                    if !(size.is_finite() && blend.is_finite()) {
+                        return skip(self, "invalid spot_size or spot_blend");
+                    }
+                    let cos_half = (0.5 * size.clamp(0.0, PI)).cos();
+                    let smooth = (1.0 - cos_half) * blend.clamp(0.0, 1.0);
+                    Some((direction, SpotFalloff::Cycles { cos_half, smooth }))
+                } else {
+                    None
                 };
-                let size = f("spot_size", FRAC_PI_4);
-                let blend = f("spot_blend", 0.15);
-                if !(size.is_finite() && blend.is_finite()) {
-                    return skip(self, "invalid spot_size or spot_blend");
-                }
-                let cos_half = (0.5 * size.clamp(0.0, PI)).cos();
-                let smooth = (1.0 - cos_half) * blend.clamp(0.0, 1.0);
-                self.scene.lights.push(Light::Spot {
+                LightShape::Point {
                     position,
-                    direction,
                     intensity,
-                    falloff: SpotFalloff::Cycles { cos_half, smooth },
-                });
+                    radius,
+                    soft_falloff: member(t, "soft_falloff")
+                        .and_then(Value::as_bool)
+                        .unwrap_or(true),
+                    spot,
+                }
             }
             "SUN" => {
                 let irradiance = color * f("strength", 1.0);
-                let angle = f("angle", 0.0);
+                let mut angle = f("angle", 0.0);
                 let Some(direction) = direction else {
                     return skip(self, "degenerate direction");
                 };
-                if !valid_color(irradiance) || !angle.is_finite() {
-                    return skip(self, "invalid color, strength or angle");
+                if !valid_color(irradiance) {
+                    return skip(self, "invalid color or strength");
                 }
-                self.scene.lights.push(Light::Directional {
+                if !(angle.is_finite() && (0.0..=PI).contains(&angle)) {
+                    let fallback = if angle.is_finite() {
+                        angle.clamp(0.0, PI)
+                    } else {
+                        0.0
+                    };
+                    self.warn_once(format!(
+                        "node {ni}: TESELA_light SUN: angle {angle} is outside [0, π]; \
+                         rendered as {fallback}"
+                    ));
+                    angle = fallback;
+                }
+                LightShape::Sun {
                     direction,
                     irradiance,
-                    angle: angle.clamp(0.0, PI),
-                });
+                    angle,
+                }
             }
             "AREA" => {
                 let shape = member(t, "shape")
                     .and_then(Value::as_str)
                     .unwrap_or("SQUARE");
+                let ellipse = matches!(shape, "DISK" | "ELLIPSE");
                 let size = f("size", 1.0);
                 let size_y = match shape {
                     "RECTANGLE" | "ELLIPSE" => f("size_y", size),
@@ -227,85 +214,56 @@ impl<'a> Loader<'a> {
                 if !(size.is_finite() && size_y.is_finite() && size > 0.0 && size_y > 0.0) {
                     return skip(self, "invalid size");
                 }
-                let local = area_light_prim(shape, size, size_y);
-                let Some((positions, _, indices)) = super::mesh::to_world(&local, world) else {
-                    return skip(self, "transform overflows");
+                let mut spread = f("spread", PI);
+                if !(spread.is_finite() && (0.0..=PI).contains(&spread)) {
+                    self.warn_once(format!(
+                        "node {ni}: TESELA_light AREA: spread {spread} is outside [0, π]; \
+                         rendered as π (no spread)"
+                    ));
+                    spread = PI;
+                }
+                // The node's transform places and sizes the light (its scale scales the size).
+                let center = world.transform_point3(Vec3::ZERO);
+                let wu = world.transform_vector3(Vec3::X);
+                let wv = world.transform_vector3(Vec3::Y);
+                let (lu, lv) = (wu.length(), wv.length());
+                let axis_u = wu.try_normalize();
+                let axis_v = axis_u.and_then(|u| (wv - u * wv.dot(u)).try_normalize());
+                let (Some(axis_u), Some(axis_v)) = (axis_u, axis_v) else {
+                    return skip(self, "degenerate transform");
                 };
-                let area = mesh_area(&positions, &indices);
+                let plane = axis_u.cross(axis_v);
+                let facing = world.transform_vector3(-Vec3::Z);
+                // The emitting side follows the node's -Z (mirrored nodes flip it); a flattened
+                // node (zero Z scale) keeps the right-handed -Z.
+                let normal = if facing.dot(plane) > 0.0 {
+                    plane
+                } else {
+                    -plane
+                };
+                let (size_u, size_v) = (size * lu, size_y * lv);
+                let area = size_u * size_v * if ellipse { PI / 4.0 } else { 1.0 };
                 let radiance = color * power / (PI * area);
-                if !(area > 0.0 && valid_color(radiance)) {
+                if !(area > 0.0 && area.is_finite() && valid_color(radiance)) {
                     return skip(self, "zero area, or invalid color or power");
                 }
-                let name = self.root.nodes[ni]
-                    .name
-                    .clone()
-                    .unwrap_or_else(|| format!("area light {ni}"));
-                self.scene
-                    .materials
-                    .push(Material::emitter(&name, radiance, false));
-                let material = self.scene.materials.len() - 1;
-                self.tri_total = self.tri_total.saturating_add(indices.len());
-                self.vert_total = self.vert_total.saturating_add(positions.len());
-                if self.tri_total > super::MAX_TRIANGLES {
-                    return Err(LoadError::new(
-                        LoadErrorKind::TooLarge,
-                        "the scene exceeds the triangle limit".to_string(),
-                    ));
+                LightShape::Area {
+                    center,
+                    axis_u,
+                    axis_v,
+                    normal,
+                    size_u,
+                    size_v,
+                    ellipse,
+                    radiance,
+                    spread,
                 }
-                self.scene.meshes.push(Mesh {
-                    name,
-                    positions,
-                    normals: Vec::new(),
-                    uvs: Vec::new(),
-                    indices,
-                    material,
-                    hidden_from_camera: !member(t, "visible_camera")
-                        .and_then(Value::as_bool)
-                        .unwrap_or(true),
-                    attrs: Default::default(),
-                });
             }
             other => {
                 return skip(self, &format!("unknown type `{other}`"));
             }
-        }
+        };
+        self.scene.lights.push(Light::Blender { shape, visibility });
         Ok(())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn face_normal(p: &[Vec3], t: [u32; 3]) -> Vec3 {
-        let [a, b, c] = t.map(|i| p[i as usize]);
-        (b - a).cross(c - a).normalize()
-    }
-
-    #[test]
-    fn area_lights_face_minus_z_with_the_right_area() {
-        for (shape, sx, sy) in [
-            ("SQUARE", 2.0, 2.0),
-            ("RECTANGLE", 2.0, 0.5),
-            ("DISK", 1.0, 1.0),
-            ("ELLIPSE", 2.0, 1.0),
-        ] {
-            let l = area_light_prim(shape, sx, sy);
-            for t in &l.tris {
-                assert!(
-                    face_normal(&l.positions, *t).abs_diff_eq(-Vec3::Z, 1e-5),
-                    "{shape}"
-                );
-            }
-            let a = mesh_area(&l.positions, &l.tris);
-            let want = if shape == "DISK" || shape == "ELLIPSE" {
-                // A regular 64-gon inscribed in the ellipse.
-                let n = DISK_SEGMENTS as f32;
-                0.5 * n * (2.0 * PI / n).sin() * (sx / 2.0) * (sy / 2.0)
-            } else {
-                sx * sy
-            };
-            assert!((a - want).abs() < 1e-4 * want, "{shape}: {a} vs {want}");
-        }
     }
 }

@@ -1,7 +1,7 @@
 //! Materials, textures, samplers and images.
 
 use ::gltf::json;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use json::texture::{MagFilter, WrappingMode};
 use json::validation::Checked;
 use serde_json::Value;
@@ -9,7 +9,7 @@ use serde_json::Value;
 use super::{
     LoadError, LoadErrorKind, Loader, extension, invalid, member, num, rgb, short_uri, uri,
 };
-use crate::scene::{Image, Material, TexRef, Texture, Wrap};
+use crate::scene::{AlphaMode, Image, Material, TexRef, Texture, UvTransform, Wrap};
 
 /// Largest accepted image side, in pixels.
 const MAX_IMAGE_SIDE: u32 = 16384;
@@ -63,26 +63,93 @@ fn finite_or(v: f32, default: f32) -> f32 {
     if v.is_finite() { v } else { default }
 }
 
+/// `v[key]` as a finite `f32`, `default` when absent; `Err` when present but not a finite number.
+fn factor(v: &Value, key: &str, default: f32) -> Result<f32, ()> {
+    match member(v, key) {
+        None => Ok(default),
+        Some(x) => x
+            .as_f64()
+            .map(|x| x as f32)
+            .filter(|x| x.is_finite())
+            .ok_or(()),
+    }
+}
+
+/// `v[key]` as a finite `[f32; N]`, `default` when absent; `Err` when malformed.
+fn factors<const N: usize>(v: &Value, key: &str, default: [f32; N]) -> Result<[f32; N], ()> {
+    let Some(x) = member(v, key) else {
+        return Ok(default);
+    };
+    let a = x.as_array().filter(|a| a.len() == N).ok_or(())?;
+    let mut out = default;
+    for (o, x) in out.iter_mut().zip(a) {
+        *o = x
+            .as_f64()
+            .map(|x| x as f32)
+            .filter(|x| x.is_finite())
+            .ok_or(())?;
+    }
+    Ok(out)
+}
+
 impl<'a> Loader<'a> {
-    /// The scene material for glTF material `gi` (or the default material for `None`).
-    pub(crate) fn material(&mut self, gi: Option<usize>) -> Result<usize, LoadError> {
-        let Some(gi) = gi else {
-            if let Some(d) = self.default_material {
-                return Ok(d);
-            }
-            self.scene.materials.push(Material::default());
-            let d = self.scene.materials.len() - 1;
-            self.default_material = Some(d);
-            return Ok(d);
-        };
-        if let Some(&m) = self.materials.get(&gi) {
+    /// The scene material for glTF material `gi` (or the default material for `None`);
+    /// `vertex_color`: the primitive has COLOR_0, which multiplies the base colour (a variant of
+    /// the material; graph materials read colour attributes by name instead).
+    pub(crate) fn material(
+        &mut self,
+        gi: Option<usize>,
+        vertex_color: bool,
+    ) -> Result<usize, LoadError> {
+        if let Some(&m) = self.materials.get(&(gi, vertex_color)) {
             return Ok(m);
         }
-        let m = self.build_material(gi)?;
+        let mut m = match gi {
+            Some(gi) => self.build_material(gi)?,
+            None => Material::default(),
+        };
+        // A graph material has one variant: it reads colour attributes itself.
+        let has_graph = m.graph.is_some();
+        m.vertex_color = vertex_color && !has_graph;
         self.scene.materials.push(m);
         let idx = self.scene.materials.len() - 1;
-        self.materials.insert(gi, idx);
+        self.materials.insert((gi, vertex_color), idx);
+        if has_graph {
+            self.materials.insert((gi, !vertex_color), idx);
+        }
         Ok(idx)
+    }
+
+    /// A warning about material `gi`, once.
+    fn warn_material(&mut self, gi: usize, name: &str, what: String) {
+        self.warn_once(format!("material {gi} (`{name}`): {what}"));
+    }
+
+    /// `raw[key]` as a factor of material `gi`: malformed values are warned about and take
+    /// `default`; the result is clamped to `[lo, hi]`.
+    #[allow(clippy::too_many_arguments)]
+    fn mat_factor(
+        &mut self,
+        gi: usize,
+        name: &str,
+        raw: &Value,
+        what: &str,
+        key: &str,
+        default: f32,
+        lo: f32,
+        hi: f32,
+    ) -> f32 {
+        match factor(raw, key, default) {
+            Ok(v) => v.clamp(lo, hi),
+            Err(()) => {
+                self.warn_material(
+                    gi,
+                    name,
+                    format!("{what} `{key}` is not a finite number; using {default}"),
+                );
+                default
+            }
+        }
     }
 
     fn build_material(&mut self, gi: usize) -> Result<Material, LoadError> {
@@ -93,6 +160,7 @@ impl<'a> Loader<'a> {
             ))
         })?;
         let raw = self.raw_item("materials", gi);
+        let name = m.name.clone().unwrap_or_else(|| format!("material{gi}"));
         let raw_pbr = member(raw, "pbrMetallicRoughness").unwrap_or(&Value::Null);
         let pbr = &m.pbr_metallic_roughness;
         let bc = pbr.base_color_factor.0;
@@ -102,24 +170,63 @@ impl<'a> Loader<'a> {
         } else {
             Vec3::ONE
         };
-        let base_color_texture = self.tex_ref(
-            pbr.base_color_texture.as_ref(),
+        let alpha = finite_or(bc[3], 1.0).clamp(0.0, 1.0);
+        let alpha_mode = match &m.alpha_mode {
+            Checked::Valid(json::material::AlphaMode::Opaque) => AlphaMode::Opaque,
+            Checked::Valid(json::material::AlphaMode::Blend) => AlphaMode::Blend,
+            Checked::Valid(json::material::AlphaMode::Mask) => {
+                let c = m.alpha_cutoff.map_or(0.5, |c| c.0);
+                let cutoff = if c.is_finite() && c >= 0.0 {
+                    c
+                } else {
+                    self.warn_material(
+                        gi,
+                        &name,
+                        format!("alphaCutoff {c} is not a non-negative number; using 0.5"),
+                    );
+                    0.5
+                };
+                AlphaMode::Mask { cutoff }
+            }
+            Checked::Invalid => {
+                self.warn_material(
+                    gi,
+                    &name,
+                    "alphaMode is not OPAQUE, MASK or BLEND; rendered opaque".into(),
+                );
+                AlphaMode::Opaque
+            }
+        };
+        let base_color_texture = self.tex_info(
             member(raw_pbr, "baseColorTexture"),
             gi,
+            &name,
             "baseColorTexture",
         )?;
-        let metallic_roughness_texture = self.tex_ref(
-            pbr.metallic_roughness_texture.as_ref(),
+        let metallic_roughness_texture = self.tex_info(
             member(raw_pbr, "metallicRoughnessTexture"),
             gi,
+            &name,
             "metallicRoughnessTexture",
         )?;
-        let emission_texture = self.tex_ref(
-            m.emissive_texture.as_ref(),
-            member(raw, "emissiveTexture"),
-            gi,
-            "emissiveTexture",
-        )?;
+        let emission_texture =
+            self.tex_info(member(raw, "emissiveTexture"), gi, &name, "emissiveTexture")?;
+        let raw_normal = member(raw, "normalTexture");
+        let normal_texture = self.tex_info(raw_normal, gi, &name, "normalTexture")?;
+        let normal_scale = match raw_normal {
+            Some(n) => self.mat_factor(
+                gi,
+                &name,
+                n,
+                "normalTexture",
+                "scale",
+                1.0,
+                f32::MIN,
+                f32::MAX,
+            ),
+            None => 1.0,
+        };
+        self.occlusion(raw, gi, &name);
         let strength = extension(raw, "KHR_materials_emissive_strength")
             .and_then(|e| num(e, "emissiveStrength"))
             .unwrap_or(1.0) as f32;
@@ -130,9 +237,19 @@ impl<'a> Loader<'a> {
             ));
             emission = Vec3::ZERO;
         }
-        let transmission = extension(raw, "KHR_materials_transmission")
+        let raw_transmission = extension(raw, "KHR_materials_transmission");
+        let transmission = raw_transmission
             .and_then(|e| num(e, "transmissionFactor"))
             .unwrap_or(0.0) as f32;
+        let transmission_texture = match raw_transmission {
+            Some(e) => self.tex_info(
+                member(e, "transmissionTexture"),
+                gi,
+                &name,
+                "KHR_materials_transmission.transmissionTexture",
+            )?,
+            None => None,
+        };
         let mut ior = extension(raw, "KHR_materials_ior")
             .and_then(|e| num(e, "ior"))
             .unwrap_or(1.5) as f32;
@@ -149,12 +266,43 @@ impl<'a> Loader<'a> {
             .filter(|c| c.is_finite())
             .unwrap_or(Vec3::ONE)
             .max(Vec3::ZERO);
+        let (specular_texture, specular_color_texture) = match spec {
+            Some(e) => (
+                self.tex_info(
+                    member(e, "specularTexture"),
+                    gi,
+                    &name,
+                    "KHR_materials_specular.specularTexture",
+                )?,
+                self.tex_info(
+                    member(e, "specularColorTexture"),
+                    gi,
+                    &name,
+                    "KHR_materials_specular.specularColorTexture",
+                )?,
+            ),
+            None => (None, None),
+        };
+        let clearcoat = match extension(raw, "KHR_materials_clearcoat") {
+            Some(e) => Some(self.clearcoat(e, gi, &name)?),
+            None => None,
+        };
+        let sheen = match extension(raw, "KHR_materials_sheen") {
+            Some(e) => Some(self.sheen(e, gi, &name)?),
+            None => None,
+        };
+        let anisotropy = match extension(raw, "KHR_materials_anisotropy") {
+            Some(e) => Some(self.anisotropy(e, gi, &name)?),
+            None => None,
+        };
+        let transmissive = transmission > 0.0 || transmission_texture.is_some();
+        let volume =
+            extension(raw, "KHR_materials_volume").map(|e| self.volume(e, gi, &name, transmissive));
         let double_sided = m.double_sided;
         let emission_two_sided = extension(raw, "TESELA_emission")
             .and_then(|e| member(e, "two_sided"))
             .and_then(Value::as_bool)
             .unwrap_or(double_sided);
-        let name = m.name.clone().unwrap_or_else(|| format!("material{gi}"));
         let graph = match extension(raw, "TESELA_material_graph") {
             Some(g) => Some(std::sync::Arc::new(self.material_graph(g, gi, &name)?)),
             None => None,
@@ -174,8 +322,213 @@ impl<'a> Loader<'a> {
             specular: finite_or(specular, 1.0).clamp(0.0, 1.0),
             specular_color,
             double_sided,
+            alpha,
+            alpha_mode,
+            vertex_color: false,
+            normal_texture,
+            normal_scale,
+            transmission_texture,
+            specular_texture,
+            specular_color_texture,
+            clearcoat,
+            sheen,
+            anisotropy,
+            volume,
             graph,
         })
+    }
+
+    /// `occlusionTexture` is read and checked but not rendered: a path tracer computes the
+    /// occlusion an ambient-occlusion map approximates (so does Blender's importer, which
+    /// leaves it unconnected). A broken reference is warned about, not an error.
+    fn occlusion(&mut self, raw: &Value, gi: usize, name: &str) {
+        let Some(o) = member(raw, "occlusionTexture") else {
+            return;
+        };
+        let ok = member(o, "index")
+            .and_then(Value::as_u64)
+            .is_some_and(|i| (i as usize) < self.root.textures.len());
+        if !ok {
+            self.warn_material(
+                gi,
+                name,
+                "occlusionTexture does not name an existing texture (it is not rendered anyway)"
+                    .into(),
+            );
+        }
+    }
+
+    fn clearcoat(
+        &mut self,
+        e: &Value,
+        gi: usize,
+        name: &str,
+    ) -> Result<crate::scene::Clearcoat, LoadError> {
+        let what = "KHR_materials_clearcoat";
+        let factor = self.mat_factor(gi, name, e, what, "clearcoatFactor", 0.0, 0.0, 1.0);
+        let roughness =
+            self.mat_factor(gi, name, e, what, "clearcoatRoughnessFactor", 0.0, 0.0, 1.0);
+        let raw_normal = member(e, "clearcoatNormalTexture");
+        let normal_scale = match raw_normal {
+            Some(n) => self.mat_factor(
+                gi,
+                name,
+                n,
+                "clearcoatNormalTexture",
+                "scale",
+                1.0,
+                f32::MIN,
+                f32::MAX,
+            ),
+            None => 1.0,
+        };
+        Ok(crate::scene::Clearcoat {
+            factor,
+            texture: self.tex_info(
+                member(e, "clearcoatTexture"),
+                gi,
+                name,
+                "KHR_materials_clearcoat.clearcoatTexture",
+            )?,
+            roughness,
+            roughness_texture: self.tex_info(
+                member(e, "clearcoatRoughnessTexture"),
+                gi,
+                name,
+                "KHR_materials_clearcoat.clearcoatRoughnessTexture",
+            )?,
+            normal_texture: self.tex_info(
+                raw_normal,
+                gi,
+                name,
+                "KHR_materials_clearcoat.clearcoatNormalTexture",
+            )?,
+            normal_scale,
+        })
+    }
+
+    fn sheen(
+        &mut self,
+        e: &Value,
+        gi: usize,
+        name: &str,
+    ) -> Result<crate::scene::Sheen, LoadError> {
+        let what = "KHR_materials_sheen";
+        let color = match factors(e, "sheenColorFactor", [0.0; 3]) {
+            Ok(c) => Vec3::from_array(c).max(Vec3::ZERO),
+            Err(()) => {
+                self.warn_material(
+                    gi,
+                    name,
+                    format!("{what} `sheenColorFactor` is not three finite numbers; using black"),
+                );
+                Vec3::ZERO
+            }
+        };
+        let roughness = self.mat_factor(gi, name, e, what, "sheenRoughnessFactor", 0.0, 0.0, 1.0);
+        Ok(crate::scene::Sheen {
+            color,
+            color_texture: self.tex_info(
+                member(e, "sheenColorTexture"),
+                gi,
+                name,
+                "KHR_materials_sheen.sheenColorTexture",
+            )?,
+            roughness,
+            roughness_texture: self.tex_info(
+                member(e, "sheenRoughnessTexture"),
+                gi,
+                name,
+                "KHR_materials_sheen.sheenRoughnessTexture",
+            )?,
+        })
+    }
+
+    fn anisotropy(
+        &mut self,
+        e: &Value,
+        gi: usize,
+        name: &str,
+    ) -> Result<crate::scene::Anisotropy, LoadError> {
+        let what = "KHR_materials_anisotropy";
+        let strength = self.mat_factor(gi, name, e, what, "anisotropyStrength", 0.0, 0.0, 1.0);
+        let rotation = self.mat_factor(gi, name, e, what, "anisotropyRotation", 0.0, -1.0e6, 1.0e6);
+        Ok(crate::scene::Anisotropy {
+            strength,
+            rotation,
+            texture: self.tex_info(
+                member(e, "anisotropyTexture"),
+                gi,
+                name,
+                "KHR_materials_anisotropy.anisotropyTexture",
+            )?,
+        })
+    }
+
+    /// `KHR_materials_volume`: the renderer refracts through every transmissive mesh as a solid
+    /// (as Cycles does), so thin-walled (thickness 0) surfaces render as solids, with a note;
+    /// attenuation is not rendered yet, with a warning. The thickness texture only serves
+    /// rasterisers' approximations and is not needed by a path tracer.
+    fn volume(
+        &mut self,
+        e: &Value,
+        gi: usize,
+        name: &str,
+        transmissive: bool,
+    ) -> crate::scene::Volume {
+        let what = "KHR_materials_volume";
+        let thickness = self.mat_factor(gi, name, e, what, "thicknessFactor", 0.0, 0.0, f32::MAX);
+        let attenuation_distance = match member(e, "attenuationDistance") {
+            None => f32::INFINITY,
+            Some(_) => self.mat_factor(
+                gi,
+                name,
+                e,
+                what,
+                "attenuationDistance",
+                f32::INFINITY,
+                0.0,
+                f32::INFINITY,
+            ),
+        };
+        let attenuation_color = match factors(e, "attenuationColor", [1.0; 3]) {
+            Ok(c) => Vec3::from_array(c).max(Vec3::ZERO),
+            Err(()) => {
+                self.warn_material(
+                    gi,
+                    name,
+                    format!("{what} `attenuationColor` is not three finite numbers; using white"),
+                );
+                Vec3::ONE
+            }
+        };
+        if transmissive && thickness == 0.0 {
+            self.warn_material(
+                gi,
+                name,
+                format!(
+                    "{what}: thickness 0 means thin-walled, which is rendered as a solid (transmissive meshes refract as solids)"
+                ),
+            );
+        }
+        if transmissive
+            && attenuation_distance.is_finite()
+            && attenuation_distance > 0.0
+            && attenuation_color != Vec3::ONE
+        {
+            self.warn_material(
+                gi,
+                name,
+                format!(
+                    "{what}: attenuation (colour {attenuation_color}, distance {attenuation_distance} m) is not rendered yet; the volume is clear"
+                ),
+            );
+        }
+        crate::scene::Volume {
+            thickness,
+            attenuation_color,
+            attenuation_distance,
+        }
     }
 
     /// Parses a `TESELA_material_graph` and resolves its image references. A graph that does
@@ -212,7 +565,7 @@ impl<'a> Loader<'a> {
 
     /// The scene image of entry `ii` of the root `TESELA_images` list when the file has one,
     /// else of glTF image `ii`.
-    fn graph_image(&mut self, ii: usize) -> Result<usize, LoadError> {
+    pub(super) fn graph_image(&mut self, ii: usize) -> Result<usize, LoadError> {
         let list = self
             .raw_root_extension("TESELA_images")
             .and_then(|e| member(e, "images"))
@@ -333,23 +686,85 @@ impl<'a> Loader<'a> {
         })
     }
 
-    fn tex_ref(
+    /// A textureInfo (`raw`: its JSON object) of material `gi`'s `slot`: the texture, its
+    /// `texCoord` and `KHR_texture_transform` (whose `texCoord` overrides). A missing or
+    /// malformed index is an error naming the material and the slot; a malformed `texCoord`
+    /// or transform is warned about and ignored.
+    fn tex_info(
         &mut self,
-        info: Option<&json::texture::Info>,
         raw: Option<&Value>,
         gi: usize,
+        name: &str,
         slot: &str,
     ) -> Result<Option<TexRef>, LoadError> {
-        let Some(info) = info else { return Ok(None) };
-        if raw
-            .and_then(|r| extension(r, "KHR_texture_transform"))
-            .is_some()
-        {
-            self.warn_once(
-                "KHR_texture_transform is not applied (textures are sampled untransformed)".into(),
+        let Some(raw) = raw else { return Ok(None) };
+        let ti = member(raw, "index")
+            .and_then(Value::as_u64)
+            .ok_or_else(|| {
+                invalid(format!(
+                    "material {gi} (`{name}`) {slot}: `index` is not a non-negative integer"
+                ))
+            })? as usize;
+        let mut texcoord = match member(raw, "texCoord") {
+            None => 0,
+            Some(v) => match v.as_u64().and_then(|v| u32::try_from(v).ok()) {
+                Some(t) => t,
+                None => {
+                    self.warn_material(
+                        gi,
+                        name,
+                        format!("{slot}: texCoord {v} is not a set index; TEXCOORD_0 is used"),
+                    );
+                    0
+                }
+            },
+        };
+        let mut transform = None;
+        if let Some(t) = extension(raw, "KHR_texture_transform") {
+            let parsed = (
+                factors(t, "offset", [0.0, 0.0]),
+                factor(t, "rotation", 0.0),
+                factors(t, "scale", [1.0, 1.0]),
             );
+            match parsed {
+                (Ok(offset), Ok(rotation), Ok(scale)) => {
+                    let tr = UvTransform {
+                        offset: Vec2::from_array(offset),
+                        rotation,
+                        scale: Vec2::from_array(scale),
+                    };
+                    if tr.matrix().iter().all(|x| x.is_finite()) {
+                        let identity = offset == [0.0, 0.0] && rotation == 0.0 && scale == [1.0, 1.0];
+                        transform = (!identity).then_some(tr);
+                    } else {
+                        self.warn_material(
+                            gi,
+                            name,
+                            format!("{slot}: KHR_texture_transform overflows; ignored"),
+                        );
+                    }
+                }
+                _ => self.warn_material(
+                    gi,
+                    name,
+                    format!(
+                        "{slot}: KHR_texture_transform has a malformed or non-finite offset, rotation or scale; ignored"
+                    ),
+                ),
+            }
+            if let Some(v) = member(t, "texCoord") {
+                match v.as_u64().and_then(|v| u32::try_from(v).ok()) {
+                    Some(tc) => texcoord = tc,
+                    None => self.warn_material(
+                        gi,
+                        name,
+                        format!(
+                            "{slot}: KHR_texture_transform texCoord {v} is not a set index; ignored"
+                        ),
+                    ),
+                }
+            }
         }
-        let ti = info.index.value();
         let raw_texture = self.raw_item("textures", ti);
         if raw_texture.is_object() && member(raw_texture, "source").is_none() {
             self.warn_once(format!(
@@ -362,7 +777,8 @@ impl<'a> Loader<'a> {
             .map_err(|e| LoadError::new(e.kind, format!("material {gi} {slot}: {}", e.message)))?;
         Ok(Some(TexRef {
             texture,
-            texcoord: info.tex_coord,
+            texcoord,
+            transform,
         }))
     }
 

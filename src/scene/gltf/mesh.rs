@@ -1,15 +1,22 @@
-//! Mesh primitives: attributes, morph targets, triangulation, and flattening to world space.
+//! Mesh primitives: attributes (POSITION, NORMAL, TEXCOORD_n, COLOR_n, TANGENT, as far as the
+//! material reads them), morph targets, triangulation, MikkTSpace tangents, flattening to world
+//! space, and the per-object data shading reads (object space, texture space, Object Info).
 
 use std::rc::Rc;
 
 use ::gltf::json;
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 use json::accessor::Type;
 use json::mesh::{Mode, Semantic};
 use json::validation::Checked;
+use serde_json::Value;
 
-use super::{LoadError, LoadErrorKind, Loader, LocalPrim, MAX_TRIANGLES, MAX_VERTICES, invalid};
-use crate::scene::Mesh;
+use super::accessor::{Comp, Values, decode_f32};
+use super::{
+    LoadError, LoadErrorKind, Loader, LocalPrim, MAX_TRIANGLES, MAX_VERTICES, invalid, member,
+};
+use crate::scene::{Material, Mesh, MeshAttributes, ObjectInfo, TexRef};
+use crate::shading::globals::from_blender;
 
 fn mode_name(m: Mode) -> &'static str {
     match m {
@@ -83,6 +90,126 @@ pub(crate) fn to_world(local: &LocalPrim, m: Mat4) -> Option<WorldPrim> {
     Some((positions, normals, tris))
 }
 
+/// What of a primitive's optional attributes its material reads (only that is stored).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Needs {
+    /// Every UV and colour set and the file's TANGENT: node graphs read them by name.
+    all: bool,
+    /// TEXCOORD sets the material's textures read.
+    uv_sets: Vec<u32>,
+    /// COLOR_0 multiplies the base colour.
+    color0: bool,
+    /// Tangents for this UV set: the file's TANGENT, else MikkTSpace.
+    tangent_set: Option<u32>,
+}
+
+impl Needs {
+    fn uv(&self, k: u32) -> bool {
+        self.all || self.uv_sets.contains(&k)
+    }
+}
+
+/// The textures of a material with their slot names (for messages).
+pub(crate) fn texture_slots(m: &Material) -> Vec<(&'static str, TexRef)> {
+    let mut v = Vec::new();
+    let mut add = |slot: &'static str, t: &Option<TexRef>| {
+        if let Some(t) = t {
+            v.push((slot, *t));
+        }
+    };
+    add("baseColorTexture", &m.base_color_texture);
+    add("metallicRoughnessTexture", &m.metallic_roughness_texture);
+    add("normalTexture", &m.normal_texture);
+    add("emissiveTexture", &m.emission_texture);
+    add("transmissionTexture", &m.transmission_texture);
+    add("specularTexture", &m.specular_texture);
+    add("specularColorTexture", &m.specular_color_texture);
+    if let Some(c) = &m.clearcoat {
+        add("clearcoatTexture", &c.texture);
+        add("clearcoatRoughnessTexture", &c.roughness_texture);
+        add("clearcoatNormalTexture", &c.normal_texture);
+    }
+    if let Some(s) = &m.sheen {
+        add("sheenColorTexture", &s.color_texture);
+        add("sheenRoughnessTexture", &s.roughness_texture);
+    }
+    if let Some(a) = &m.anisotropy {
+        add("anisotropyTexture", &a.texture);
+    }
+    v
+}
+
+fn needs(m: &Material) -> Needs {
+    if m.graph.is_some() {
+        return Needs {
+            all: true,
+            ..Default::default()
+        };
+    }
+    let slots = texture_slots(m);
+    let mut uv_sets: Vec<u32> = slots.iter().map(|(_, t)| t.texcoord).collect();
+    uv_sets.sort_unstable();
+    uv_sets.dedup();
+    let coat_normal = m.clearcoat.as_ref().and_then(|c| c.normal_texture);
+    let aniso = m.anisotropy.as_ref().filter(|a| a.strength > 0.0);
+    let tangent_set = m
+        .normal_texture
+        .or(coat_normal)
+        .or(aniso.and_then(|a| a.texture))
+        .map(|t| t.texcoord)
+        .or(aniso.map(|_| 0));
+    Needs {
+        all: false,
+        uv_sets,
+        color0: m.vertex_color,
+        tangent_set,
+    }
+}
+
+/// Blender's automatic texture space of local bounds `(lo, hi)`: centre and half extents, a
+/// zero extent taken as 1 and tiny ones raised to 1e-5 (`BKE_mesh_texspace_calc`).
+pub(crate) fn auto_texspace(lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
+    let loc = (lo + hi) * 0.5;
+    let size = ((hi - lo) * 0.5).to_array().map(|s| {
+        if s == 0.0 {
+            1.0
+        } else if s.abs() < 1e-5 {
+            1e-5f32.copysign(s)
+        } else {
+            s
+        }
+    });
+    (loc, Vec3::from_array(size))
+}
+
+/// `v` as `[f32; N]` of finite numbers.
+fn floats<const N: usize>(v: Option<&Value>) -> Option<[f32; N]> {
+    let a = v?.as_array().filter(|a| a.len() == N)?;
+    let mut out = [0.0; N];
+    for (o, x) in out.iter_mut().zip(a) {
+        *o = x.as_f64().map(|x| x as f32).filter(|x| x.is_finite())?;
+    }
+    Some(out)
+}
+
+/// Names from a primitive's `extras` list `key` (one per set; non-strings are `None`).
+fn extra_names(extras: Option<&Value>, key: &str) -> Vec<Option<String>> {
+    extras
+        .and_then(|e| member(e, key))
+        .and_then(Value::as_array)
+        .map(|a| a.iter().map(|n| n.as_str().map(str::to_string)).collect())
+        .unwrap_or_default()
+}
+
+/// Blender's default name of set `k` of a kind (`UVMap`, `UVMap.001`, ...).
+fn default_name(base: &str, k: usize) -> String {
+    if k == 0 {
+        base.to_string()
+    } else {
+        format!("{base}.{k:03}")
+    }
+}
+
 impl<'a> Loader<'a> {
     pub(crate) fn instance_mesh(
         &mut self,
@@ -105,22 +232,92 @@ impl<'a> Loader<'a> {
             .clone()
             .or_else(|| node.name.clone())
             .unwrap_or_else(|| format!("mesh{mi}"));
+        let mut prims: Vec<(usize, Rc<LocalPrim>, usize)> = Vec::new();
         for (pi, prim) in mesh.primitives.iter().enumerate() {
+            let has = |s: Semantic| prim.attributes.contains_key(&Checked::Valid(s));
+            let renders = matches!(
+                prim.mode,
+                Checked::Valid(Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan)
+            ) && has(Semantic::Positions);
+            let material = if renders {
+                let vc = has(Semantic::Colors(0));
+                Some(self.material(prim.material.map(|m| m.value()), vc)?)
+            } else {
+                None
+            };
+            let needs = material
+                .map(|m| needs(&self.scene.materials[m]))
+                .unwrap_or_default();
             let local = if cacheable {
                 if let Some(c) = self.prim_cache.get(&(mi, pi)) {
                     c.clone()
                 } else {
-                    let l = self.local_prim(mi, pi, prim, weights)?.map(Rc::new);
+                    let l = self.local_prim(mi, pi, prim, weights, &needs)?.map(Rc::new);
                     self.prim_cache.insert((mi, pi), l.clone());
                     l
                 }
             } else {
-                self.local_prim(mi, pi, prim, weights)?.map(Rc::new)
+                self.local_prim(mi, pi, prim, weights, &needs)?.map(Rc::new)
             };
-            let Some(local) = local else { continue };
+            let (Some(local), Some(material)) = (local, material) else {
+                continue;
+            };
             if local.tris.is_empty() {
                 continue;
             }
+            for (slot, t) in texture_slots(&self.scene.materials[material]) {
+                let k = t.texcoord;
+                if !has(Semantic::TexCoords(k)) {
+                    let fallback = if k > 0 && has(Semantic::TexCoords(0)) {
+                        "TEXCOORD_0 is used instead"
+                    } else {
+                        "it reads UV (0, 0)"
+                    };
+                    let mname = self.scene.materials[material].name.clone();
+                    self.warn_once(format!(
+                        "material `{mname}` {slot} reads TEXCOORD_{k}, which mesh {mi} primitive {pi} does not have; {fallback}"
+                    ));
+                }
+            }
+            prims.push((pi, local, material));
+        }
+        if prims.is_empty() {
+            return Ok(());
+        }
+        // Per-object data: the node's extras (written by the add-on) or what the file implies.
+        let extras = member(self.raw_item("nodes", ni), "extras");
+        let texspace = match extras.and_then(|e| member(e, "tesela_texspace")) {
+            Some(t) => match (
+                floats::<3>(member(t, "location")),
+                floats::<3>(member(t, "size")),
+            ) {
+                (Some(l), Some(s)) => Some((Vec3::from_array(l), Vec3::from_array(s))),
+                _ => {
+                    self.warn_once(format!(
+                        "node {ni}: extras.tesela_texspace is not {{location: [x, y, z], size: [x, y, z]}}; the mesh bounds are used"
+                    ));
+                    None
+                }
+            },
+            None => None,
+        };
+        let texspace = texspace.or_else(|| {
+            let mut lo = Vec3::splat(f32::INFINITY);
+            let mut hi = Vec3::splat(f32::NEG_INFINITY);
+            for (_, l, _) in &prims {
+                for &p in &l.positions {
+                    lo = lo.min(p);
+                    hi = hi.max(p);
+                }
+            }
+            (lo.cmple(hi).all()).then(|| auto_texspace(lo, hi))
+        });
+        let object = self.object_info(ni, extras, world);
+        let to_object = Some(world.inverse())
+            .filter(|m| m.is_finite())
+            .unwrap_or(Mat4::IDENTITY);
+        let single = mesh.primitives.len() == 1;
+        for (pi, local, material) in prims {
             let (positions, normals, indices) = to_world(&local, world).ok_or_else(|| {
                 invalid(format!(
                     "mesh {mi} primitive {pi} on node {ni}: positions are not finite in world space"
@@ -146,34 +343,175 @@ impl<'a> Loader<'a> {
                     ),
                 ));
             }
-            let material = self.material(prim.material.map(|m| m.value()))?;
-            let name = if mesh.primitives.len() > 1 {
-                format!("{base_name}.{pi}")
-            } else {
+            let name = if single {
                 base_name.clone()
+            } else {
+                format!("{base_name}.{pi}")
             };
-            let uvs = local.uvs.clone();
+            let attrs = MeshAttributes {
+                uv_names: local.uv_names.clone(),
+                extra_uvs: local.extra_uvs.clone(),
+                colors: local.colors.clone(),
+                tangents: super::tangents::to_world(&local.tangents, world),
+                to_object,
+                texspace,
+                object: object.clone(),
+            };
             self.scene.meshes.push(Mesh {
                 name,
                 positions,
                 normals,
-                uvs,
+                uvs: local.uvs.clone(),
                 indices,
                 material,
                 hidden_from_camera: false,
-                attrs: Default::default(),
+                attrs,
             });
         }
         Ok(())
     }
 
-    /// Reads and triangulates one primitive in local space; `None` for skipped modes.
+    /// Object Info data of node `ni`: `extras.tesela_object` (Blender's world coordinates),
+    /// else defaults with the node's origin as the location.
+    fn object_info(&mut self, ni: usize, extras: Option<&Value>, world: Mat4) -> ObjectInfo {
+        let mut info = ObjectInfo {
+            location: world.w_axis.truncate(),
+            ..Default::default()
+        };
+        let Some(o) = extras.and_then(|e| member(e, "tesela_object")) else {
+            return info;
+        };
+        let mut bad = Vec::new();
+        match member(o, "random").map(|v| v.as_f64().map(|x| x as f32)) {
+            None => {}
+            Some(Some(r)) if r.is_finite() => info.random = r,
+            Some(_) => bad.push("random"),
+        }
+        match member(o, "pass_index").map(|v| v.as_f64().map(|x| x as f32)) {
+            None => {}
+            Some(Some(p)) if p.is_finite() => info.pass_index = p,
+            Some(_) => bad.push("pass_index"),
+        }
+        match member(o, "color") {
+            None => {}
+            Some(c) => match floats::<4>(Some(c))
+                .or_else(|| floats::<3>(Some(c)).map(|[r, g, b]| [r, g, b, 1.0]))
+            {
+                Some(c) => info.color = glam::Vec4::from_array(c),
+                None => bad.push("color"),
+            },
+        }
+        match member(o, "location") {
+            None => {}
+            Some(l) => match floats::<3>(Some(l)) {
+                Some(l) => info.location = from_blender(Vec3::from_array(l)),
+                None => bad.push("location"),
+            },
+        }
+        if !bad.is_empty() {
+            self.warn_once(format!(
+                "node {ni}: extras.tesela_object has an invalid {}; defaults are used for it",
+                bad.join(", ")
+            ));
+        }
+        info
+    }
+
+    /// A float attribute of `count` elements of type `ty` (count checked).
+    fn attribute(
+        &self,
+        ai: usize,
+        what: &str,
+        ty: Type,
+        count: usize,
+    ) -> Result<Values<f32>, LoadError> {
+        let v = self.reader.read_f32(ai, what, ty)?;
+        if v.count != count {
+            return Err(invalid(format!(
+                "accessor {ai} ({what}): count {} differs from POSITION's {count}",
+                v.count
+            )));
+        }
+        Ok(v)
+    }
+
+    /// COLOR_n: VEC3 or VEC4 of FLOAT or normalized UNSIGNED_BYTE/UNSIGNED_SHORT, as linear
+    /// RGBA (alpha 1 for VEC3). Non-finite components read as 0, with a warning.
+    fn color_attribute(
+        &mut self,
+        ai: usize,
+        what: &str,
+        count: usize,
+    ) -> Result<Vec<glam::Vec4>, LoadError> {
+        let (acc, comp, ty) = self.reader.describe(ai, what)?;
+        let width = match ty {
+            Type::Vec3 => 3,
+            Type::Vec4 => 4,
+            other => {
+                return Err(invalid(format!(
+                    "accessor {ai} ({what}): type {} where VEC3 or VEC4 is expected",
+                    super::accessor::type_name(other)
+                )));
+            }
+        };
+        match comp {
+            Comp::F32 => {}
+            Comp::U8 | Comp::U16 => {
+                if !acc.normalized {
+                    self.warn_once(format!(
+                        "accessor {ai} ({what}): integer colours must be normalized; read as normalized"
+                    ));
+                }
+            }
+            _ => {
+                return Err(invalid(format!(
+                    "accessor {ai} ({what}): componentType must be FLOAT, UNSIGNED_BYTE or UNSIGNED_SHORT"
+                )));
+            }
+        }
+        let v = self
+            .reader
+            .read(ai, what, &|b, c, _| decode_f32(b, c, c != Comp::F32))?;
+        if v.count != count {
+            return Err(invalid(format!(
+                "accessor {ai} ({what}): count {} differs from POSITION's {count}",
+                v.count
+            )));
+        }
+        let mut bad = 0usize;
+        let out = v
+            .data
+            .chunks_exact(width)
+            .map(|c| {
+                let mut px = [0.0, 0.0, 0.0, 1.0];
+                for (o, &x) in px.iter_mut().zip(c) {
+                    if x.is_finite() {
+                        *o = x;
+                    } else {
+                        *o = 0.0;
+                        bad += 1;
+                    }
+                }
+                glam::Vec4::from_array(px)
+            })
+            .collect();
+        if bad > 0 {
+            self.warn_once(format!(
+                "accessor {ai} ({what}): {bad} components are not finite and read as 0"
+            ));
+        }
+        Ok(out)
+    }
+
+    /// Reads and triangulates one primitive in local space; `None` for skipped modes. Reads
+    /// the optional attributes `needs` asks for.
     fn local_prim(
         &mut self,
         mi: usize,
         pi: usize,
         prim: &json::mesh::Primitive,
         weights: Option<&[f32]>,
+        needs: &Needs,
     ) -> Result<Option<LocalPrim>, LoadError> {
         let mode = match prim.mode {
             Checked::Valid(m) => m,
@@ -198,42 +536,123 @@ impl<'a> Loader<'a> {
             ));
             return Ok(None);
         };
-        let rd = &self.reader;
         let what = |a: &str| format!("{a} of mesh {mi} primitive {pi}");
-        let pos = rd.read_f32(pos_ai, &what("POSITION"), Type::Vec3)?;
+        let pos = self
+            .reader
+            .read_f32(pos_ai, &what("POSITION"), Type::Vec3)?;
         let count = pos.count;
         let mut positions = pos.vec3();
         let mut normals = match attr(Semantic::Normals) {
-            Some(ai) => {
-                let v = rd.read_f32(ai, &what("NORMAL"), Type::Vec3)?;
-                if v.count != count {
-                    return Err(invalid(format!(
-                        "accessor {ai} ({}): count {} differs from POSITION's {count}",
-                        what("NORMAL"),
-                        v.count
-                    )));
-                }
-                v.vec3()
-            }
+            Some(ai) => self
+                .attribute(ai, &what("NORMAL"), Type::Vec3, count)?
+                .vec3(),
             None => Vec::new(),
+        };
+        let read_uv = |this: &Self, k: u32, ai: usize| -> Result<Vec<Vec2>, LoadError> {
+            let d = this.attribute(ai, &what(&format!("TEXCOORD_{k}")), Type::Vec2, count)?;
+            Ok(d.vec2()
+                .into_iter()
+                .map(|t| if t.is_finite() { t } else { Vec2::ZERO })
+                .collect())
         };
         let uvs = match attr(Semantic::TexCoords(0)) {
-            Some(ai) => {
-                let v = rd.read_f32(ai, &what("TEXCOORD_0"), Type::Vec2)?;
-                if v.count != count {
-                    return Err(invalid(format!(
-                        "accessor {ai} ({}): count {} differs from POSITION's {count}",
-                        what("TEXCOORD_0"),
-                        v.count
-                    )));
-                }
-                v.vec2()
-                    .into_iter()
-                    .map(|t| if t.is_finite() { t } else { glam::Vec2::ZERO })
-                    .collect()
-            }
+            Some(ai) => read_uv(self, 0, ai)?,
             None => Vec::new(),
         };
+        // Further UV sets and colour sets, as far as the file has them and the material reads
+        // them.
+        let max_set = |f: fn(&Semantic) -> Option<u32>| {
+            prim.attributes
+                .keys()
+                .filter_map(|k| match k {
+                    Checked::Valid(s) => f(s),
+                    Checked::Invalid => None,
+                })
+                .max()
+        };
+        let extras = member(self.raw_item("meshes", mi), "primitives")
+            .and_then(|p| p.get(pi))
+            .and_then(|p| member(p, "extras"));
+        let max_uv = max_set(|s| match s {
+            Semantic::TexCoords(k) => Some(*k),
+            _ => None,
+        });
+        let mut extra_uvs: Vec<Vec<Vec2>> = Vec::new();
+        let mut uv_names = Vec::new();
+        if let Some(max_uv) = max_uv {
+            let names = extra_names(extras, "tesela_uv_names");
+            for k in 0..=max_uv {
+                uv_names.push(
+                    names
+                        .get(k as usize)
+                        .cloned()
+                        .flatten()
+                        .unwrap_or_else(|| default_name("UVMap", k as usize)),
+                );
+                if k == 0 {
+                    continue;
+                }
+                let set = match attr(Semantic::TexCoords(k)) {
+                    Some(ai) if needs.uv(k) => read_uv(self, k, ai)?,
+                    _ => Vec::new(),
+                };
+                extra_uvs.push(set);
+            }
+            while extra_uvs.last().is_some_and(Vec::is_empty) {
+                extra_uvs.pop();
+            }
+        }
+        let mut colors = Vec::new();
+        if let Some(max_col) = max_set(|s| match s {
+            Semantic::Colors(k) => Some(*k),
+            _ => None,
+        }) {
+            let names = extra_names(extras, "tesela_color_names");
+            for k in 0..=max_col {
+                let Some(ai) = attr(Semantic::Colors(k)) else {
+                    continue;
+                };
+                if !(needs.all || (k == 0 && needs.color0)) {
+                    continue;
+                }
+                let data = self.color_attribute(ai, &what(&format!("COLOR_{k}")), count)?;
+                let name = names
+                    .get(k as usize)
+                    .cloned()
+                    .flatten()
+                    .unwrap_or_else(|| default_name("Col", k as usize));
+                colors.push((name, data));
+            }
+        }
+        let want_tangents = needs.all || needs.tangent_set.is_some();
+        let mut tangents = match attr(Semantic::Tangents) {
+            Some(ai) if want_tangents => {
+                let d = self.attribute(ai, &what("TANGENT"), Type::Vec4, count)?;
+                let mut bad = 0usize;
+                let t: Vec<glam::Vec4> = d
+                    .data
+                    .chunks_exact(4)
+                    .map(|c| {
+                        let v = glam::Vec4::new(c[0], c[1], c[2], c[3]);
+                        if v.is_finite() {
+                            v
+                        } else {
+                            bad += 1;
+                            glam::Vec4::new(0.0, 0.0, 0.0, 1.0)
+                        }
+                    })
+                    .collect();
+                if bad > 0 {
+                    self.warn_once(format!(
+                        "accessor {ai} ({}): {bad} tangents are not finite; those vertices use the triangle's UV direction",
+                        what("TANGENT")
+                    ));
+                }
+                t
+            }
+            _ => Vec::new(),
+        };
+        let rd = &self.reader;
         // Morph targets at the default weights.
         if let (Some(targets), Some(weights)) = (&prim.targets, weights) {
             for (ti, (t, &w)) in targets.iter().zip(weights.iter()).enumerate() {
@@ -276,6 +695,28 @@ impl<'a> Loader<'a> {
                         *n += w * dn;
                     }
                 }
+                if let Some(ai) = t.tangents
+                    && !tangents.is_empty()
+                {
+                    let d = rd.read_f32(
+                        ai.value(),
+                        &what(&format!("TANGENT of morph target {ti}")),
+                        Type::Vec3,
+                    )?;
+                    if d.count != count {
+                        return Err(invalid(format!(
+                            "accessor {} (morph target {ti} TANGENT of mesh {mi} primitive {pi}): count {} differs from POSITION's {count}",
+                            ai.value(),
+                            d.count
+                        )));
+                    }
+                    for (t, dt) in tangents.iter_mut().zip(d.vec3()) {
+                        let v = t.truncate() + w * dt;
+                        if v.is_finite() {
+                            *t = v.extend(t.w);
+                        }
+                    }
+                }
             }
         }
         if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
@@ -314,12 +755,28 @@ impl<'a> Loader<'a> {
                 triangulate(mode, &idx)
             }
         };
-        Ok(Some(LocalPrim {
+        let mut local = LocalPrim {
             positions,
             normals,
             uvs,
             tris,
-        }))
+            extra_uvs,
+            uv_names,
+            colors,
+            tangents,
+        };
+        if let Some(set) = needs.tangent_set
+            && local.tangents.is_empty()
+            && !local.tris.is_empty()
+        {
+            // The glTF specification: without TANGENT, MikkTSpace on the normal texture's UVs.
+            if let Err(e) = super::tangents::generate(&mut local, set as usize) {
+                self.warn_once(format!(
+                    "mesh {mi} primitive {pi}: no tangents for its normal map ({e}); each triangle's UV direction is used"
+                ));
+            }
+        }
+        Ok(Some(local))
     }
 }
 
@@ -348,6 +805,7 @@ mod tests {
             normals: vec![Vec3::Z; 3],
             uvs: vec![],
             tris: vec![[0, 1, 2]],
+            ..Default::default()
         }
     }
 

@@ -7,19 +7,25 @@
 //! [`accessor`], and the node tree is walked iteratively with a visited set.
 //!
 //! Extensions read from the raw JSON: `KHR_lights_punctual`, `KHR_materials_*`
-//! (emissive_strength, ior, transmission, specular), `KHR_mesh_quantization` (accessor
-//! types), and Tesela's own `TESELA_light`, `TESELA_world`, `TESELA_emission`,
-//! `TESELA_render` (see `docs/extensions.md`).
+//! (emissive_strength, ior, transmission, specular, clearcoat, sheen, volume, anisotropy),
+//! `KHR_texture_transform`, `KHR_mesh_quantization` (accessor types), and Tesela's own `TESELA_light`, `TESELA_world`, `TESELA_emission`,
+//! `TESELA_render`, `TESELA_camera` (see `docs/extensions.md`).
 
 mod accessor;
+mod camera;
 mod container;
 mod lights;
 mod material;
 mod mesh;
+mod tangents;
 mod uri;
+mod world;
 
 #[cfg(test)]
 mod tests_load;
+
+#[cfg(test)]
+mod tests_attributes;
 
 use std::borrow::Cow;
 use std::collections::{HashMap, HashSet};
@@ -31,7 +37,7 @@ use glam::{Mat3, Mat4, Quat, Vec3, Vec4};
 use serde_json::Value;
 
 use crate::scene::error::{LoadError, LoadErrorKind};
-use crate::scene::{Camera, Projection, RenderSettings, Scene};
+use crate::scene::{RenderSettings, Scene};
 
 /// Output limits: a scene beyond them is refused rather than exhausting memory.
 const MAX_TRIANGLES: usize = 1 << 25;
@@ -44,6 +50,10 @@ const SUPPORTED_REQUIRED: &[&str] = &[
     "KHR_materials_ior",
     "KHR_materials_transmission",
     "KHR_materials_specular",
+    "KHR_materials_clearcoat",
+    "KHR_materials_sheen",
+    "KHR_materials_volume",
+    "KHR_materials_anisotropy",
     "KHR_lights_punctual",
     "KHR_texture_transform",
     "TESELA_light",
@@ -52,10 +62,12 @@ const SUPPORTED_REQUIRED: &[&str] = &[
     "TESELA_render",
     "TESELA_material_graph",
     "TESELA_images",
+    "TESELA_camera",
 ];
 
-/// Extensions that are used without a warning (`KHR_texture_transform` is accepted but
-/// not applied: a warning says so where a texture uses it).
+/// Extensions that are used without a warning. Clearcoat, sheen and anisotropy reach the
+/// Principled BSDF's inputs; where the BSDF cannot draw a lobe yet, the material compiler
+/// reports it. Volume attenuation, which is not rendered yet, is reported by the loader.
 const UNDERSTOOD: &[&str] = &[
     "KHR_mesh_quantization",
     "KHR_texture_transform",
@@ -63,6 +75,10 @@ const UNDERSTOOD: &[&str] = &[
     "KHR_materials_ior",
     "KHR_materials_transmission",
     "KHR_materials_specular",
+    "KHR_materials_clearcoat",
+    "KHR_materials_sheen",
+    "KHR_materials_volume",
+    "KHR_materials_anisotropy",
     "KHR_lights_punctual",
     "TESELA_light",
     "TESELA_world",
@@ -70,6 +86,7 @@ const UNDERSTOOD: &[&str] = &[
     "TESELA_render",
     "TESELA_material_graph",
     "TESELA_images",
+    "TESELA_camera",
 ];
 
 /// Loads a `.gltf` or `.glb` file. External files are resolved relative to its folder
@@ -152,7 +169,6 @@ fn load_inner(bytes: &[u8], base_dir: Option<&Path>) -> Result<Scene, LoadError>
             ..Default::default()
         },
         materials: HashMap::new(),
-        default_material: None,
         textures: HashMap::new(),
         images: HashMap::new(),
         raw_images: HashMap::new(),
@@ -326,11 +342,20 @@ fn short_uri(u: &str) -> String {
 }
 
 /// Triangulated primitive data in the mesh's local space.
+#[derive(Clone, Debug, Default)]
 pub(crate) struct LocalPrim {
     pub positions: Vec<Vec3>,
     pub normals: Vec<Vec3>,
     pub uvs: Vec<glam::Vec2>,
     pub tris: Vec<[u32; 3]>,
+    /// TEXCOORD_1.. (empty where absent or not needed).
+    pub extra_uvs: Vec<Vec<glam::Vec2>>,
+    /// Names of the TEXCOORD sets (`uv_names[k]` names set k).
+    pub uv_names: Vec<String>,
+    /// COLOR_n, linear RGBA, with their names.
+    pub colors: Vec<(String, Vec<Vec4>)>,
+    /// Local-space tangents (TANGENT or MikkTSpace), w = bitangent sign; may be empty.
+    pub tangents: Vec<Vec4>,
 }
 
 pub(crate) struct Loader<'a> {
@@ -339,9 +364,9 @@ pub(crate) struct Loader<'a> {
     pub base_dir: Option<&'a Path>,
     pub reader: accessor::Reader<'a>,
     pub scene: Scene,
-    /// glTF material index -> scene material index.
-    pub materials: HashMap<usize, usize>,
-    pub default_material: Option<usize>,
+    /// (glTF material index or `None` for the default, multiplied by COLOR_0) -> scene
+    /// material index.
+    pub materials: HashMap<(Option<usize>, bool), usize>,
     /// glTF texture index -> scene texture index.
     pub textures: HashMap<usize, usize>,
     /// glTF image index -> scene image index.
@@ -404,16 +429,7 @@ impl<'a> Loader<'a> {
 
     fn root_extensions(&mut self) -> Result<(), LoadError> {
         if let Some(w) = extension(self.raw, "TESELA_world") {
-            let color = rgb(w, "color").unwrap_or(Vec3::ZERO);
-            let strength = num(w, "strength").unwrap_or(1.0) as f32;
-            let bg = color * strength;
-            if bg.is_finite() && bg.min_element() >= 0.0 {
-                self.scene.background = bg;
-            } else {
-                self.scene
-                    .warnings
-                    .push("TESELA_world: invalid color or strength, ignored".into());
-            }
+            self.world(w);
         }
         if let Some(r) = extension(self.raw, "TESELA_render") {
             let mut s = RenderSettings::default();
@@ -430,6 +446,9 @@ impl<'a> Loader<'a> {
             s.integrator = member(r, "integrator")
                 .and_then(Value::as_str)
                 .map(str::to_string);
+            s.film_transparent = member(r, "film_transparent")
+                .and_then(Value::as_bool)
+                .unwrap_or(false);
             self.scene.settings = s;
         }
         Ok(())
@@ -501,64 +520,6 @@ impl<'a> Loader<'a> {
             }
         }
         Ok(())
-    }
-
-    fn camera(&self, ci: usize, ni: usize, world: Mat4) -> Result<Camera, LoadError> {
-        let cam = self.root.cameras.get(ci).ok_or_else(|| {
-            invalid(format!(
-                "node {ni}: camera {ci} does not exist (the file has {})",
-                self.root.cameras.len()
-            ))
-        })?;
-        use json::camera::Type as T;
-        use json::validation::Checked;
-        let (projection, aspect) = match (&cam.type_, &cam.perspective, &cam.orthographic) {
-            (Checked::Valid(T::Perspective), Some(p), _) => {
-                let y = p.yfov;
-                if !(y.is_finite() && y > 0.0 && y < std::f32::consts::PI) {
-                    return Err(invalid(format!(
-                        "camera {ci}: perspective yfov {y} is not in (0, pi)"
-                    )));
-                }
-                let aspect = p.aspect_ratio.filter(|a| a.is_finite() && *a > 0.0);
-                (Projection::Perspective { yfov: y }, aspect)
-            }
-            (Checked::Valid(T::Orthographic), _, Some(o)) => {
-                let m = o.ymag.abs();
-                if !(m.is_finite() && m > 0.0) {
-                    return Err(invalid(format!(
-                        "camera {ci}: orthographic ymag {} is zero or not finite",
-                        o.ymag
-                    )));
-                }
-                let x = o.xmag.abs();
-                let aspect = (x.is_finite() && x > 0.0).then_some(x / m);
-                (Projection::Orthographic { ymag: m }, aspect)
-            }
-            (Checked::Valid(T::Perspective), None, _) => {
-                return Err(invalid(format!(
-                    "camera {ci}: type perspective without a `perspective` object"
-                )));
-            }
-            (Checked::Valid(T::Orthographic), _, None) => {
-                return Err(invalid(format!(
-                    "camera {ci}: type orthographic without an `orthographic` object"
-                )));
-            }
-            (Checked::Invalid, _, _) => {
-                return Err(invalid(format!("camera {ci}: invalid type")));
-            }
-        };
-        let to_world = orthonormalize(world).ok_or_else(|| {
-            invalid(format!(
-                "node {ni}: camera transform is degenerate (zero scale)"
-            ))
-        })?;
-        Ok(Camera {
-            projection,
-            to_world,
-            aspect,
-        })
     }
 }
 

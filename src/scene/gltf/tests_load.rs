@@ -8,18 +8,25 @@ use glam::{Mat4, Quat, Vec3};
 use serde_json::{Value, json};
 
 use super::load_from_slice;
-use crate::scene::{Light, Projection, Scene, SpotFalloff};
+use crate::scene::{Light, LightShape, LightVisibility, Projection, Scene, SpotFalloff};
 
 /// Builds the binary part of a test document.
 #[derive(Default)]
-struct Bin {
+pub(super) struct Bin {
     bytes: Vec<u8>,
     views: Vec<Value>,
     accessors: Vec<Value>,
 }
 
 impl Bin {
-    fn add(&mut self, data: &[u8], comp: u32, count: usize, ty: &str, normalized: bool) -> usize {
+    pub(super) fn add(
+        &mut self,
+        data: &[u8],
+        comp: u32,
+        count: usize,
+        ty: &str,
+        normalized: bool,
+    ) -> usize {
         while !self.bytes.len().is_multiple_of(4) {
             self.bytes.push(0);
         }
@@ -34,18 +41,30 @@ impl Bin {
         self.accessors.len() - 1
     }
 
-    fn vec3(&mut self, v: &[[f32; 3]]) -> usize {
+    pub(super) fn vec3(&mut self, v: &[[f32; 3]]) -> usize {
         let b: Vec<u8> = v.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
         self.add(&b, 5126, v.len(), "VEC3", false)
     }
 
-    fn indices(&mut self, i: &[u16]) -> usize {
+    /// FLOAT components, `ty` naming the element type (`VEC2`, `VEC4`, ...).
+    pub(super) fn floats(&mut self, v: &[f32], ty: &str) -> usize {
+        let width = match ty {
+            "SCALAR" => 1,
+            "VEC2" => 2,
+            "VEC3" => 3,
+            _ => 4,
+        };
+        let b: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
+        self.add(&b, 5126, v.len() / width, ty, false)
+    }
+
+    pub(super) fn indices(&mut self, i: &[u16]) -> usize {
         let b: Vec<u8> = i.iter().flat_map(|x| x.to_le_bytes()).collect();
         self.add(&b, 5123, i.len(), "SCALAR", false)
     }
 
     /// Completes `doc` with the buffer, views and accessors.
-    fn finish(self, mut doc: Value) -> Vec<u8> {
+    pub(super) fn finish(self, mut doc: Value) -> Vec<u8> {
         let b64 = base64::engine::general_purpose::STANDARD.encode(&self.bytes);
         doc["asset"] = json!({ "version": "2.0" });
         doc["buffers"] = json!([{
@@ -58,7 +77,7 @@ impl Bin {
     }
 }
 
-fn load(bytes: &[u8]) -> Scene {
+pub(super) fn load(bytes: &[u8]) -> Scene {
     load_from_slice(bytes, None, "test.gltf").unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -359,35 +378,48 @@ fn tesela_light_overrides_the_khr_copy() {
         None,
         json!([
             { "extensions": both, "translation": [0, 1, 0] },
-            { "extensions": { "TESELA_light": { "type": "SPOT", "power": 40.0, "color": [1, 0, 0], "spot_size": 1.0, "spot_blend": 0.2 } } },
-            { "extensions": { "TESELA_light": { "type": "SUN", "strength": 3.0, "color": [1, 1, 0.5], "angle": 0.01 } } }
+            { "extensions": { "TESELA_light": { "type": "SPOT", "power": 40.0, "color": [1, 0, 0], "spot_size": 1.0, "spot_blend": 0.2, "radius": 0.1, "soft_falloff": false } } },
+            { "extensions": { "TESELA_light": { "type": "SUN", "strength": 3.0, "color": [1, 1, 0.5], "angle": 0.01,
+                                                "visible_camera": false, "visible_glossy": false, "cast_shadow": false } } }
         ]),
         json!([{ "type": "point", "intensity": 5435.14 }]),
     );
     let s = load(&bytes);
     assert_eq!(s.lights.len(), 3);
-    match &s.lights[0] {
-        Light::Point {
+    let blender = |i: usize| match &s.lights[i] {
+        Light::Blender { shape, visibility } => (*shape, *visibility),
+        l => panic!("{l:?}"),
+    };
+    let (shape, vis) = blender(0);
+    assert_eq!(vis, LightVisibility::default());
+    match shape {
+        LightShape::Point {
             position,
             intensity,
+            radius,
+            soft_falloff,
+            spot,
         } => {
-            assert_eq!(*position, Vec3::Y);
+            assert_eq!(position, Vec3::Y);
             assert!(intensity.abs_diff_eq(Vec3::splat(100.0 / (4.0 * PI)), 1e-5));
+            assert_eq!((radius, soft_falloff, spot), (0.0, true, None));
         }
         l => panic!("{l:?}"),
     }
-    match &s.lights[1] {
-        Light::Spot {
+    match blender(1).0 {
+        LightShape::Point {
             intensity,
-            falloff,
-            direction,
+            radius,
+            soft_falloff,
+            spot: Some((direction, falloff)),
             ..
         } => {
             assert!(intensity.abs_diff_eq(Vec3::new(40.0 / (4.0 * PI), 0., 0.), 1e-5));
             assert!(direction.abs_diff_eq(-Vec3::Z, 1e-6));
+            assert_eq!((radius, soft_falloff), (0.1, false));
             let ch = 0.5f32.cos();
             assert_eq!(
-                *falloff,
+                falloff,
                 SpotFalloff::Cycles {
                     cos_half: ch,
                     smooth: (1.0 - ch) * 0.2
@@ -396,27 +428,37 @@ fn tesela_light_overrides_the_khr_copy() {
         }
         l => panic!("{l:?}"),
     }
-    match &s.lights[2] {
-        Light::Directional {
+    let (shape, vis) = blender(2);
+    match shape {
+        LightShape::Sun {
             irradiance, angle, ..
         } => {
             assert!(irradiance.abs_diff_eq(Vec3::new(3., 3., 1.5), 1e-6));
-            assert_eq!(*angle, 0.01);
+            assert_eq!(angle, 0.01);
         }
         l => panic!("{l:?}"),
     }
+    assert_eq!(
+        vis,
+        LightVisibility {
+            camera: false,
+            glossy: false,
+            cast_shadow: false,
+            ..Default::default()
+        }
+    );
     assert!(s.warnings.is_empty(), "{:?}", s.warnings);
 }
 
 #[test]
-fn tesela_area_lights_become_one_sided_emitters() {
+fn tesela_area_lights_keep_their_shape() {
     // A 2 m square under a node scaled by 2 and turned to face down (-Z -> -Y).
     let rot = Quat::from_rotation_x(-FRAC_PI_2);
     let bytes = lights_doc(
         None,
         json!([
             { "name": "Key", "rotation": rot.to_array(), "scale": [2, 2, 2], "translation": [0, 3, 0],
-              "extensions": { "TESELA_light": { "type": "AREA", "shape": "SQUARE", "size": 2.0, "power": 100.0, "color": [1, 0.5, 1] } } },
+              "extensions": { "TESELA_light": { "type": "AREA", "shape": "SQUARE", "size": 2.0, "power": 100.0, "color": [1, 0.5, 1], "spread": 1.0 } } },
             { "extensions": { "TESELA_light": { "type": "AREA", "shape": "DISK", "size": 1.0, "power": 10.0 } } },
             { "extensions": { "TESELA_light": { "type": "AREA", "shape": "RECTANGLE", "size": 2.0, "size_y": 0.5, "power": 10.0 } } },
             { "scale": [1, 1, -1],
@@ -425,35 +467,89 @@ fn tesela_area_lights_become_one_sided_emitters() {
         json!([]),
     );
     let s = load(&bytes);
-    assert!(s.lights.is_empty());
-    assert_eq!(s.meshes.len(), 4);
-    let sq = &s.meshes[0];
-    assert_eq!(sq.name, "Key");
-    assert_eq!(sq.indices.len(), 2);
-    assert!(sq.positions.iter().all(|p| (p.y - 3.0).abs() < 1e-5));
+    assert!(s.meshes.is_empty(), "lights are not geometry");
+    assert_eq!(s.lights.len(), 4);
+    let area = |i: usize| match s.lights[i] {
+        Light::Blender {
+            shape:
+                LightShape::Area {
+                    center,
+                    normal,
+                    size_u,
+                    size_v,
+                    ellipse,
+                    radiance,
+                    spread,
+                    ..
+                },
+            ..
+        } => (center, normal, size_u, size_v, ellipse, radiance, spread),
+        ref l => panic!("{l:?}"),
+    };
+    let (center, normal, su, sv, ellipse, radiance, spread) = area(0);
+    assert!(center.abs_diff_eq(Vec3::new(0., 3., 0.), 1e-6));
+    assert!(normal.abs_diff_eq(-Vec3::Y, 1e-5), "faces the node's -Z");
     assert!(
-        face_normal(&s, 0).abs_diff_eq(-Vec3::Y, 1e-5),
-        "faces the node's -Z"
+        (su - 4.0).abs() < 1e-5 && (sv - 4.0).abs() < 1e-5,
+        "{su} {sv}"
     );
-    let m = &s.materials[sq.material];
-    assert!(!m.emission_two_sided && !m.double_sided);
-    let area = 16.0; // (2 m × scale 2)²
+    assert_eq!((ellipse, spread), (false, 1.0));
+    assert!(radiance.abs_diff_eq(Vec3::new(1., 0.5, 1.) * 100.0 / (PI * 16.0), 1e-5));
+    let (_, normal, _, _, ellipse, radiance, spread) = area(1);
+    assert!(ellipse && spread == PI && normal.abs_diff_eq(-Vec3::Z, 1e-6));
     assert!(
-        m.emission
-            .abs_diff_eq(Vec3::new(1., 0.5, 1.) * 100.0 / (PI * area), 1e-5)
+        (radiance.x - 10.0 / (PI * PI / 4.0)).abs() < 1e-4,
+        "exact disk area"
     );
+    assert!((area(2).5.x - 10.0 / PI).abs() < 1e-4, "area 1 m²");
+    // Mirrored in Z: the light now faces +Z.
+    assert!(area(3).1.abs_diff_eq(Vec3::Z, 1e-6));
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+}
 
-    let disk = &s.meshes[1];
-    assert_eq!(disk.indices.len(), 64);
-    let poly = 0.5 * 64.0 * (2.0 * PI / 64.0).sin() * 0.25;
-    let e = s.materials[disk.material].emission;
-    assert!((e.x - 10.0 / (PI * poly)).abs() < 1e-4, "{e}");
-    assert!(face_normal(&s, 1).abs_diff_eq(-Vec3::Z, 1e-5));
-
-    let rect = &s.materials[s.meshes[2].material];
-    assert!((rect.emission.x - 10.0 / PI).abs() < 1e-4, "area 1 m²");
-    // Mirrored in Z: the light now faces +Z, and the winding follows.
-    assert!(face_normal(&s, 3).abs_diff_eq(Vec3::Z, 1e-5));
+#[test]
+fn tesela_light_bad_parameters_warn_and_fall_back() {
+    let bytes = lights_doc(
+        None,
+        json!([
+            { "extensions": { "TESELA_light": { "type": "POINT", "power": 10.0, "radius": -1.0 } } },
+            { "extensions": { "TESELA_light": { "type": "AREA", "size": 1.0, "power": 10.0, "spread": 4.0 } } },
+            { "extensions": { "TESELA_light": { "type": "AREA", "size": 1.0, "power": 10.0, "spread": -0.5 } } },
+            { "extensions": { "TESELA_light": { "type": "SUN", "strength": 1.0, "angle": 7.0 } } },
+            { "extensions": { "TESELA_light": { "type": "AREA", "size": 0.0, "power": 10.0 } } }
+        ]),
+        json!([]),
+    );
+    let s = load(&bytes);
+    assert_eq!(s.lights.len(), 4, "the zero-size area light is skipped");
+    assert!(matches!(
+        s.lights[0],
+        Light::Blender {
+            shape: LightShape::Point { radius: 0.0, .. },
+            ..
+        }
+    ));
+    for i in [1, 2] {
+        assert!(
+            matches!(s.lights[i], Light::Blender { shape: LightShape::Area { spread, .. }, .. } if spread == PI),
+            "{:?}",
+            s.lights[i]
+        );
+    }
+    assert!(matches!(
+        s.lights[3],
+        Light::Blender { shape: LightShape::Sun { angle, .. }, .. } if angle == PI
+    ));
+    let w = s.warnings.join("\n");
+    for want in [
+        "radius -1",
+        "spread 4",
+        "spread -0.5",
+        "angle 7",
+        "invalid size",
+    ] {
+        assert!(w.contains(want), "no warning about {want}: {w}");
+    }
 }
 
 #[test]
@@ -502,10 +598,10 @@ fn tesela_world_render_and_emission() {
 }
 
 #[test]
-fn texture_transform_is_accepted_with_one_warning() {
+fn texture_transform_is_read_and_samplers_shared() {
     let mut b = Bin::default();
     let p = b.vec3(&[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]]);
-    // A 1x1 PNG is not needed: the image is in a data URI built from a real encoder.
+    let uv = b.floats(&[0., 0., 1., 0., 0., 1.], "VEC2");
     let mut png = Vec::new();
     image::RgbaImage::from_pixel(2, 1, image::Rgba([10, 20, 30, 255]))
         .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
@@ -523,11 +619,15 @@ fn texture_transform_is_accepted_with_one_warning() {
         "samplers": [{ "magFilter": 9728, "wrapS": 33071, "wrapT": 33648 }],
         "textures": [{ "source": 0, "sampler": 0 }],
         "materials": [{ "pbrMetallicRoughness": { "baseColorTexture": tt.clone() }, "emissiveTexture": tt }],
-        "meshes": [{ "primitives": [{ "attributes": { "POSITION": p }, "material": 0 }] }]
+        "meshes": [{ "primitives": [{ "attributes": { "POSITION": p, "TEXCOORD_0": uv }, "material": 0 }] }]
     }));
     let s = load(&bytes);
-    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
-    assert!(s.warnings[0].contains("KHR_texture_transform"));
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let m = &s.materials[0];
+    for t in [m.base_color_texture, m.emission_texture] {
+        let tr = t.unwrap().transform.expect("the transform is kept");
+        assert_eq!(tr.scale, glam::Vec2::splat(2.0));
+    }
     assert_eq!(s.images.len(), 1);
     assert_eq!(s.textures.len(), 1, "one texture shared by two slots");
     let t = &s.textures[0];

@@ -327,6 +327,7 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
             cx.shader("Shader_001", w)?;
             return Ok(true);
         }
+        "ShaderNodeBackground" => return super::environment::compile_background(cx, w),
         "ShaderNodeBsdfPrincipled" => {
             let f = |cx: &mut NodeCx, id: &str, d: f32| cx.float(id, d);
             let c = |cx: &mut NodeCx, id: &str, d: Vec3| cx.color(id, d);

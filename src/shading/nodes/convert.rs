@@ -51,6 +51,12 @@ pub enum ConvertOp {
         b: Slot,
         out: Slot,
     },
+    /// glTF `alphaMode: MASK`: 1 where `a >= cutoff`, else 0 (NaN: 0).
+    AlphaCutoff {
+        a: Slot,
+        cutoff: f32,
+        out: Slot,
+    },
 }
 
 impl ConvertOp {
@@ -74,6 +80,9 @@ impl ConvertOp {
             ConvertOp::Combine { x, y, z, out } => s.set_v(out, Vec3::new(s.f(x), s.f(y), s.f(z))),
             ConvertOp::MulF { a, b, out } => s.set_f(out, s.f(a) * s.f(b)),
             ConvertOp::MulV { a, b, out } => s.set_v(out, s.v(a) * s.v(b)),
+            ConvertOp::AlphaCutoff { a, cutoff, out } => {
+                s.set_f(out, if s.f(a) >= cutoff { 1.0 } else { 0.0 })
+            }
         }
     }
 }
@@ -122,6 +131,16 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
                 let out = cx.output("Color", Color)?;
                 cx.emit(Op::Convert(ConvertOp::MulV { a, b, out }), false);
             }
+        }
+        "TeselaAlphaCutoff" => {
+            // Internal (glTF preset): alpha masking at `props.cutoff`.
+            let a = cx.float("Alpha", 1.0)?;
+            let cutoff = cx.prop_f32("cutoff", 0.5);
+            let out = cx.output("Alpha", Float)?;
+            cx.emit(
+                Op::Convert(ConvertOp::AlphaCutoff { a, cutoff, out }),
+                false,
+            );
         }
         _ => return Ok(false),
     }

@@ -1,12 +1,18 @@
 //! The Image Texture node: bilinear (Cycles' "Linear", no mipmaps) or closest lookups with
 //! Blender's extension modes and colour spaces.
+//!
+//! Alpha as Cycles has it: colour images (not Non-Color) whose alpha mode is Straight or
+//! Premultiplied are held with associated (premultiplied) alpha — 8-bit ones premultiplied in
+//! bytes when loaded (`c · a / 255`, truncated), float ones premultiplied already — so the
+//! Color output is premultiplied, and divided by the filtered alpha only when the node's Alpha
+//! output is used (the add-on's `alpha_linked`), before the sRGB decode.
 
-use crate::scene::{Texture, Wrap};
+use crate::scene::{Image, Texture, Wrap};
 use crate::shading::compile::{CompileError, NodeCx, SocketType};
 use crate::shading::globals::ShadeEnv;
 use crate::shading::program::{Op, Slot, Slots};
 use crate::texture;
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 #[derive(Clone, Debug)]
 pub struct ImageOp {
@@ -21,6 +27,11 @@ pub struct ImageOp {
     /// The vector input is a glTF texture coordinate (`(0, 0)` top-left) rather than Blender's
     /// UV (`(0, 0)` bottom-left).
     gltf_uv: bool,
+    /// Cycles associates the alpha (see the module's notes): 8-bit texels are premultiplied
+    /// before filtering (float ones arrive premultiplied).
+    associate: bool,
+    /// The Alpha output is used: the filtered colour is un-premultiplied.
+    unassociate: bool,
     vector: Slot,
     color: Slot,
     alpha: Slot,
@@ -40,15 +51,103 @@ impl ImageOp {
             s.set_f(self.alpha, 1.0);
             return;
         };
-        if self.clip && !(v.x >= 0.0 && v.x <= 1.0 && v.y >= 0.0 && v.y <= 1.0) {
-            s.set_v(self.color, Vec3::ZERO);
-            s.set_f(self.alpha, 0.0);
-            return;
-        }
-        let c = texture::lookup(&self.sampler, img, uv, self.srgb);
+        let byte = img.float.is_empty();
+        let c = if !self.associate && !self.clip {
+            texture::lookup(&self.sampler, img, uv, self.srgb)
+        } else {
+            let premultiply = self.associate && byte;
+            let mut c = lookup(&self.sampler, img, uv, premultiply, self.clip, self.srgb);
+            if self.unassociate && c.w != 0.0 && c.w != 1.0 {
+                c = (c.truncate() / c.w).extend(c.w);
+            }
+            if byte && self.srgb {
+                c = srgb_decode(c);
+            }
+            c
+        };
         s.set_v(self.color, c.truncate());
         s.set_f(self.alpha, c.w);
     }
+}
+
+/// Blender's extension of texel index `i` into `[0, n)`.
+#[inline]
+fn wrap_index(i: i64, n: u32, mode: Wrap) -> usize {
+    let n = n as i64;
+    (match mode {
+        Wrap::Repeat => i.rem_euclid(n),
+        Wrap::ClampToEdge => i.clamp(0, n - 1),
+        Wrap::MirroredRepeat => {
+            let p = i.rem_euclid(2 * n);
+            if p < n { p } else { 2 * n - 1 - p }
+        }
+    }) as usize
+}
+
+/// Texel `(x, y)` (rows top to bottom): 8-bit ones encoded in `[0, 1]`, premultiplied in bytes
+/// as Cycles' image loader does (`c * a / 255`, integer division) when `premultiply`; float
+/// ones linear (`srgb` decodes them per texel, as [`texture::lookup`] does).
+#[inline]
+fn texel(img: &Image, x: usize, y: usize, premultiply: bool, srgb: bool) -> Vec4 {
+    let i = y * img.width as usize + x;
+    if let Some(f) = img.float.get(i) {
+        let v = Vec4::from_array(*f);
+        return if srgb { srgb_decode(v) } else { v };
+    }
+    let [r, g, b, a] = img.rgba8[i].map(u32::from);
+    if premultiply {
+        let pm = |c: u32| (c * a / 255) as f32;
+        Vec4::new(pm(r), pm(g), pm(b), a as f32) / 255.0
+    } else {
+        Vec4::new(r as f32, g as f32, b as f32, a as f32) / 255.0
+    }
+}
+
+/// Cycles' lookup (`kernel_tex_image_interp`) at glTF `uv`, 8-bit results still encoded:
+/// closest or bilinear, with texels premultiplied when `premultiply`; with `clip` (Blender's
+/// CLIP), texels outside the image are transparent black, so bilinear lookups fade out over
+/// the half texel around the border.
+fn lookup(tex: &Texture, img: &Image, uv: Vec2, premultiply: bool, clip: bool, srgb: bool) -> Vec4 {
+    let (w, h) = (img.width, img.height);
+    if w == 0 || h == 0 || (img.rgba8.is_empty() && img.float.is_empty()) || !uv.is_finite() {
+        return Vec4::ONE;
+    }
+    let fetch = |x: i64, y: i64| {
+        if clip && (x < 0 || y < 0 || x >= w as i64 || y >= h as i64) {
+            return Vec4::ZERO;
+        }
+        let xi = wrap_index(x, w, tex.wrap_s);
+        let yi = wrap_index(y, h, tex.wrap_t);
+        texel(img, xi, yi, premultiply, srgb)
+    };
+    let x = (uv.x as f64 * w as f64 - 0.5).clamp(-1e9, 1e9);
+    let y = (uv.y as f64 * h as f64 - 0.5).clamp(-1e9, 1e9);
+    if tex.nearest {
+        return fetch((x + 0.5).floor() as i64, (y + 0.5).floor() as i64);
+    }
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
+    let (x0, y0) = (x0 as i64, y0 as i64);
+    let top = fetch(x0, y0).lerp(fetch(x0 + 1, y0), fx);
+    let bottom = fetch(x0, y0 + 1).lerp(fetch(x0 + 1, y0 + 1), fx);
+    top.lerp(bottom, fy)
+}
+
+/// The sRGB decode of a filtered, encoded colour (alpha unchanged).
+fn srgb_decode(c: Vec4) -> Vec4 {
+    let d = |v: f32| {
+        if v <= 0.04045 {
+            v / 12.92
+        } else {
+            ((v + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    Vec4::new(d(c.x), d(c.y), d(c.z), c.w)
+}
+
+/// Colour spaces Cycles treats as data (no colour conversion, no alpha association).
+fn is_data(colorspace: &str) -> bool {
+    matches!(colorspace, "Non-Color" | "Raw" | "Generic Data")
 }
 
 pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
@@ -115,6 +214,15 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             true
         }
     };
+    // Cycles' alpha association (module notes). Only graphs from Blender say how the image's
+    // alpha is to be read (`alpha_mode`); glTF textures (the preset graphs) keep straight alpha.
+    // Float pixels arrive converted ("Non-Color"): their own colour space is `source_colorspace`.
+    let source_cs = cx.prop_str("source_colorspace").unwrap_or(cs);
+    let associate = cx
+        .prop_str("alpha_mode")
+        .is_some_and(|m| !matches!(m, "CHANNEL_PACKED" | "NONE"))
+        && !is_data(source_cs);
+    let unassociate = associate && cx.prop_bool("alpha_linked", false);
     cx.emit(
         Op::Image(ImageOp {
             image,
@@ -127,6 +235,8 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             clip: ext == "CLIP",
             srgb,
             gltf_uv,
+            associate,
+            unassociate,
             vector,
             color,
             alpha,
@@ -141,5 +251,64 @@ fn gltf_wrap(s: &str) -> Wrap {
         "CLAMP_TO_EDGE" => Wrap::ClampToEdge,
         "MIRRORED_REPEAT" => Wrap::MirroredRepeat,
         _ => Wrap::Repeat,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image() -> Image {
+        // 2 x 1: a half-transparent orange texel and an opaque blue one.
+        Image {
+            width: 2,
+            height: 1,
+            rgba8: vec![[255, 101, 0, 128], [0, 0, 200, 255]],
+            float: Vec::new(),
+        }
+    }
+
+    fn tex(wrap: Wrap, nearest: bool) -> Texture {
+        Texture {
+            image: 0,
+            wrap_s: wrap,
+            wrap_t: wrap,
+            nearest,
+        }
+    }
+
+    #[test]
+    fn bytes_are_premultiplied_with_truncation() {
+        let img = image();
+        let c = texel(&img, 0, 0, true, false) * 255.0;
+        // 255 * 128 / 255 = 128, 101 * 128 / 255 = 50.7 -> 50 (Cycles' integer division).
+        assert_eq!(c, Vec4::new(128.0, 50.0, 0.0, 128.0));
+        let straight = texel(&img, 0, 0, false, false) * 255.0;
+        assert_eq!(straight, Vec4::new(255.0, 101.0, 0.0, 128.0));
+    }
+
+    #[test]
+    fn linear_clip_fades_to_transparent_black_over_half_a_texel() {
+        let img = image();
+        let t = tex(Wrap::ClampToEdge, false);
+        // Texel centres at u = 0.25 and 0.75; at u = 0 the left texel is blended half with
+        // the transparent outside, at u = -0.25 (a whole half texel out) nothing is left.
+        let edge = lookup(&t, &img, Vec2::new(0.0, 0.5), false, true, false);
+        assert!((edge - Vec4::new(0.5, 101.0 / 510.0, 0.0, 64.0 / 255.0)).length() < 1e-6);
+        let out = lookup(&t, &img, Vec2::new(-0.25, 0.5), false, true, false);
+        assert_eq!(out, Vec4::ZERO);
+        // EXTEND holds the edge texel instead.
+        let ext = lookup(&t, &img, Vec2::new(0.0, 0.5), false, false, false);
+        assert!((ext - Vec4::new(1.0, 101.0 / 255.0, 0.0, 128.0 / 255.0)).length() < 1e-6);
+    }
+
+    #[test]
+    fn closest_clip_is_black_outside_only() {
+        let img = image();
+        let t = tex(Wrap::ClampToEdge, true);
+        let inside = lookup(&t, &img, Vec2::new(0.99, 0.5), false, true, false);
+        assert_eq!(inside, Vec4::new(0.0, 0.0, 200.0 / 255.0, 1.0));
+        let outside = lookup(&t, &img, Vec2::new(1.01, 0.5), false, true, false);
+        assert_eq!(outside, Vec4::ZERO);
     }
 }

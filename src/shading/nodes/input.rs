@@ -2,9 +2,9 @@
 //! Info, Light Path, Layer Weight, Fresnel, attributes) and constant Value/RGB nodes.
 
 use crate::shading::compile::{CompileError, NodeCx, SocketType};
-use crate::shading::globals::{ShadeEnv, ShaderGlobals, ray, to_blender};
+use crate::shading::globals::{ShadeEnv, ShaderGlobals, from_blender, ray, to_blender};
 use crate::shading::program::{Op, Slot, Slots};
-use glam::{Vec2, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3};
 
 /// Which value of the shading point an [`InputOp`] writes.
 #[derive(Clone, Debug)]
@@ -82,6 +82,23 @@ pub fn fresnel_dielectric_cos(cosi: f32, eta: f32) -> f32 {
     }
 }
 
+/// Texture Coordinate > Normal: the world normal `n` (Blender coordinates) in object space as
+/// Cycles computes it (`object_inverse_normal_transform`): `normalize(Mᵀ n)` for the object's
+/// object-to-world matrix `M`, i.e. through the inverse transpose of `to_object` (world → object,
+/// renderer world coordinates). With a non-uniform scale this differs from `M⁻¹ n`.
+pub fn object_normal(to_object: &Mat4, n: Vec3) -> Vec3 {
+    let m_t = Mat3::from_mat4(*to_object).inverse().transpose();
+    unit_or(m_t * from_blender(n), n)
+}
+
+/// Texture Coordinate > Camera: the point in Cycles' camera space (x right, y up, **+z** along
+/// the view direction, so points in front have z > 0), from Blender's camera-to-world matrix
+/// (the camera looks down its local -Z).
+pub fn camera_position(camera_to_world: &Mat4, p: Vec3) -> Vec3 {
+    let c = camera_to_world.inverse().transform_point3(p);
+    Vec3::new(c.x, c.y, -c.z)
+}
+
 fn unit_or(v: Vec3, fallback: Vec3) -> Vec3 {
     let l = v.length();
     if l > 1e-12 && l.is_finite() {
@@ -98,17 +115,18 @@ impl InputOp {
         let info = g.mesh.map(|m| &m.attrs.object);
         match &self.src {
             Source::Generated => s.set_v(self.out, g.generated()),
-            Source::ObjectNormal => s.set_v(self.out, unit_or(g.object_direction(g.n), g.n)),
+            Source::ObjectNormal => s.set_v(
+                self.out,
+                g.mesh
+                    .map_or(g.n, |m| object_normal(&m.attrs.to_object, g.n)),
+            ),
             Source::Uv(name) => s.set_v(self.out, g.uv_named(name)),
             Source::GltfUv(set) => {
                 let uv: Vec2 = g.uv_gltf(*set);
                 s.set_v(self.out, uv.extend(0.0));
             }
             Source::Object => s.set_v(self.out, g.object_position()),
-            Source::Camera => {
-                let p = env.camera_to_world.inverse().transform_point3(g.p);
-                s.set_v(self.out, p);
-            }
+            Source::Camera => s.set_v(self.out, camera_position(&env.camera_to_world, g.p)),
             Source::Reflection => s.set_v(self.out, 2.0 * g.n.dot(g.i) * g.n - g.i),
             Source::Position => s.set_v(self.out, g.p),
             Source::Normal => s.set_v(self.out, g.n),
@@ -348,4 +366,33 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         _ => return Ok(false),
     }
     Ok(true)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec4;
+
+    #[test]
+    fn object_normal_uses_the_inverse_transpose() {
+        // An object scaled (2, 1, 1) (Blender object space → renderer world: the scale, then
+        // Blender's Z-up axes to the renderer's Y-up ones): a world normal at 45° in Blender's
+        // XY is, in object space, normalize(Mᵀ n) ∝ (2, 1, 0), not M⁻¹ n ∝ (0.5, 1, 0).
+        let axes = Mat4::from_cols(Vec4::X, -Vec4::Z, Vec4::Y, Vec4::W); // = from_blender
+        let object_to_world = axes * Mat4::from_scale(Vec3::new(2.0, 1.0, 1.0));
+        let to_object = object_to_world.inverse();
+        let n = Vec3::new(1.0, 1.0, 0.0).normalize(); // Blender world: X and Y
+        let got = object_normal(&to_object, n);
+        let want = Vec3::new(2.0, 1.0, 0.0).normalize();
+        assert!((got - want).length() < 1e-6, "{got:?} != {want:?}");
+    }
+
+    #[test]
+    fn camera_space_looks_down_plus_z() {
+        // A camera at Blender (0, 0, 5) looking down -Z (identity rotation): the origin lies 5 in
+        // front of it, at camera z = +5 as in Cycles; x and y keep their directions.
+        let cam = Mat4::from_translation(Vec3::new(0.0, 0.0, 5.0));
+        let c = camera_position(&cam, Vec3::new(0.25, -0.5, 0.0));
+        assert!((c - Vec3::new(0.25, -0.5, 5.0)).length() < 1e-6, "{c:?}");
+    }
 }

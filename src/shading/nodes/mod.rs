@@ -5,6 +5,7 @@ pub mod bump;
 pub mod color;
 pub mod convert;
 pub mod curves;
+pub mod environment;
 pub mod image;
 pub mod input;
 pub mod map_range;
@@ -28,6 +29,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         vector::compile,
         bump::compile,
         convert::compile,
+        environment::compile,
     ] {
         if family(kind, cx)? {
             return Ok(true);

@@ -1,0 +1,493 @@
+//! A world that varies with direction (an HDRI, a gradient sky, a camera-only backdrop): its
+//! node program evaluated per escaped ray direction, and importance-sampled as Cycles samples
+//! its background light.
+//!
+//! The sampling map is the world's luminance on an equirectangular grid (Blender's Z-up
+//! orientation, Cycles' `direction_to_equirectangular`): `w x h` cells, row 0 at the zenith,
+//! each cell's value its luminance at the cell's centre (the mean of `ss x ss` points when the
+//! environment image is finer than the map) times `sin θ` of the centre. A piecewise-constant
+//! 2D distribution over `(u, t) ∈ [0, 1]²` (`t = θ / π`) is sampled by inverting its marginal
+//! (rows) and conditional (columns) CDFs; its density per solid angle is
+//! `p(u, t) / (2π² sin θ)` with `sin θ` of the direction itself, exactly the Jacobian of the
+//! map, so `sample` and `pdf` agree everywhere. The map is evaluated as Cycles evaluates it:
+//! with no Light Path bits set (neither camera nor any bounce type).
+
+use super::{Emitter, EmitterQueryRecord, luminance};
+use crate::sampling::{square_to_uniform_sphere, square_to_uniform_sphere_pdf};
+use crate::scene::{Image, Scene, World, WorldSampling};
+use crate::shading::Program;
+use crate::shading::globals::{ShadeEnv, from_blender, to_blender};
+use crate::shading::graph::Graph;
+use crate::shading::nodes::environment::{
+    background_globals, direction_to_equirectangular, equirectangular_to_direction,
+};
+use glam::{Mat4, Vec2, Vec3};
+use rayon::prelude::*;
+use std::f32::consts::PI;
+use std::sync::Arc;
+
+/// Largest map edge (cells) chosen automatically from an environment image; finer images are
+/// averaged over up to `MAX_SUPERSAMPLE²` points per cell.
+pub const MAX_AUTO_WIDTH: usize = 2048;
+/// Largest map edge accepted from `sample_map_resolution`.
+pub const MAX_MANUAL_WIDTH: usize = 4096;
+const MAX_SUPERSAMPLE: usize = 4;
+/// Smallest map (cells): procedural worlds over a tiny image still get a useful map.
+const MIN_WIDTH: usize = 64;
+const MIN_HEIGHT: usize = 32;
+
+/// Ray depth the world is evaluated at for light sampling (a bounce, not the camera).
+const LIGHT_DEPTH: u32 = 2;
+
+/// The sampling map's size: `(width, height, supersampling per axis)`, or `None` when the
+/// world is not sampled as a light. Automatic: the largest environment image the graph uses
+/// (capped at [`MAX_AUTO_WIDTH`] wide, averaging finer texels), else 1024 x 512, as Cycles.
+pub fn map_resolution(world: &World, graph: &Graph, images: &[Image]) -> Option<[usize; 3]> {
+    let (w, h, ss) = match world.sampling {
+        WorldSampling::None => return None,
+        WorldSampling::Manual(n) => {
+            let w = (n as usize).clamp(2, MAX_MANUAL_WIDTH);
+            (w, (w / 2).max(1), 1)
+        }
+        WorldSampling::Automatic => {
+            let (mut w, mut h) = (0usize, 0usize);
+            for n in &graph.nodes {
+                if n.kind == "ShaderNodeTexEnvironment"
+                    && let Some(img) = n.image.and_then(|i| images.get(i))
+                {
+                    w = w.max(img.width as usize);
+                    h = h.max(img.height as usize);
+                }
+            }
+            if w == 0 || h == 0 {
+                (1024, 512, 1)
+            } else if w > MAX_AUTO_WIDTH || h > MAX_AUTO_WIDTH / 2 {
+                let s =
+                    (w as f64 / MAX_AUTO_WIDTH as f64).max(h as f64 / (MAX_AUTO_WIDTH / 2) as f64);
+                let ss = (s.ceil() as usize).clamp(1, MAX_SUPERSAMPLE);
+                (
+                    ((w as f64 / s) as usize).clamp(1, MAX_AUTO_WIDTH),
+                    ((h as f64 / s) as usize).clamp(1, MAX_AUTO_WIDTH / 2),
+                    ss,
+                )
+            } else {
+                (w, h, 1)
+            }
+        }
+    };
+    Some([w.max(MIN_WIDTH), h.max(MIN_HEIGHT), ss])
+}
+
+/// A piecewise-constant distribution over `[0, 1]²` on a `w x h` grid (row-major, row 0 at
+/// `t = 0`).
+#[derive(Clone, Debug)]
+pub struct Distribution2D {
+    w: usize,
+    h: usize,
+    /// Cell values (non-negative).
+    func: Vec<f32>,
+    /// Per row, the normalised CDF over its columns (`w + 1` entries; all zero for an empty row).
+    conditional: Vec<f32>,
+    /// The normalised CDF over rows (`h + 1` entries).
+    marginal: Vec<f32>,
+    /// `w h / Σ func`: a cell's value times this is the density on `[0, 1]²`.
+    norm: f32,
+}
+
+/// The normalised CDF of `f` into `out` (`f.len() + 1` entries); returns the sum.
+fn cdf_into(f: impl Iterator<Item = f64>, out: &mut Vec<f32>) -> f64 {
+    let start = out.len();
+    let mut acc = 0.0f64;
+    let mut raw = vec![0.0f64];
+    for v in f {
+        acc += v;
+        raw.push(acc);
+    }
+    if acc > 0.0 {
+        out.extend(raw.iter().map(|c| (c / acc) as f32));
+        *out.last_mut().unwrap() = 1.0;
+    } else {
+        out.extend(std::iter::repeat_n(0.0, raw.len()));
+    }
+    debug_assert_eq!(out.len() - start, raw.len());
+    acc
+}
+
+/// Samples cell and position within a CDF: `(cell, continuous coordinate in [0, 1))`.
+#[inline]
+fn sample_cdf(cdf: &[f32], u: f32) -> (usize, f32) {
+    let n = cdf.len() - 1;
+    // The first entry above u, minus one: a cell of positive width containing u.
+    let i = cdf.partition_point(|&c| c <= u).clamp(1, n) - 1;
+    let (a, b) = (cdf[i], cdf[i + 1]);
+    let du = if b > a {
+        ((u - a) / (b - a)).clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    let x = ((i as f32 + du) / n as f32).min(1.0 - f32::EPSILON / 2.0);
+    (i, x)
+}
+
+impl Distribution2D {
+    /// Builds the distribution; `None` when every value is zero (or not finite).
+    pub fn new(w: usize, h: usize, func: Vec<f32>) -> Option<Distribution2D> {
+        assert_eq!(func.len(), w * h);
+        let clean = |v: f32| {
+            if v.is_finite() && v > 0.0 {
+                v as f64
+            } else {
+                0.0
+            }
+        };
+        let func: Vec<f32> = func.iter().map(|&v| clean(v) as f32).collect();
+        let mut conditional = Vec::with_capacity((w + 1) * h);
+        let mut rows = Vec::with_capacity(h);
+        for r in func.chunks_exact(w) {
+            rows.push(cdf_into(r.iter().map(|&v| v as f64), &mut conditional));
+        }
+        let mut marginal = Vec::with_capacity(h + 1);
+        let total = cdf_into(rows.iter().copied(), &mut marginal);
+        if !(total > 0.0 && total.is_finite()) {
+            return None;
+        }
+        Some(Distribution2D {
+            w,
+            h,
+            func,
+            conditional,
+            marginal,
+            norm: ((w * h) as f64 / total) as f32,
+        })
+    }
+
+    /// A point of `[0, 1)²` and its density.
+    #[inline]
+    pub fn sample(&self, u: Vec2) -> (Vec2, f32) {
+        let (j, t) = sample_cdf(&self.marginal, u.y);
+        let row = &self.conditional[j * (self.w + 1)..(j + 1) * (self.w + 1)];
+        let (i, x) = sample_cdf(row, u.x);
+        (Vec2::new(x, t), self.func[j * self.w + i] * self.norm)
+    }
+
+    /// The density at a point of `[0, 1]²`.
+    #[inline]
+    pub fn pdf(&self, p: Vec2) -> f32 {
+        let i = ((p.x * self.w as f32) as usize).min(self.w - 1);
+        let j = ((p.y * self.h as f32) as usize).min(self.h - 1);
+        self.func[j * self.w + i] * self.norm
+    }
+}
+
+/// A direction-dependent world.
+#[derive(Clone, Debug)]
+pub struct Environment {
+    program: Arc<Program>,
+    /// The camera in Blender's coordinates (Texture Coordinate's Camera output).
+    camera_to_world: Mat4,
+    /// The importance map; `None`: uniform over the sphere (a world whose luminance does not
+    /// vary, e.g. a constant colour behind a camera-only backdrop).
+    dist: Option<Box<Distribution2D>>,
+    /// `∫ luminance dω` over the sphere, for light selection (0: not a light).
+    integral: f32,
+}
+
+/// Cycles' equirectangular `(u, v)` of a cell-space point `(u, t)` (`t = θ / π` from the top).
+#[inline]
+fn cell_direction(u: f32, t: f32) -> Vec3 {
+    from_blender(equirectangular_to_direction(u, 1.0 - t))
+}
+
+impl Environment {
+    /// The world `program` (a compiled world graph) with an importance map of `res`
+    /// ([`map_resolution`]; `None`: not a light).
+    pub fn new(
+        scene: &Scene,
+        program: Arc<Program>,
+        camera_to_world: Mat4,
+        res: Option<[usize; 3]>,
+    ) -> Environment {
+        let mut env = Environment {
+            program,
+            camera_to_world,
+            dist: None,
+            integral: 0.0,
+        };
+        let Some([w, h, ss]) = res else {
+            return env;
+        };
+        let mut lum = vec![0.0f32; w * h];
+        lum.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
+            for (i, out) in row.iter_mut().enumerate() {
+                let mut sum = 0.0f64;
+                for a in 0..ss {
+                    for b in 0..ss {
+                        let u = (i as f32 + (b as f32 + 0.5) / ss as f32) / w as f32;
+                        let t = (j as f32 + (a as f32 + 0.5) / ss as f32) / h as f32;
+                        let l = luminance(env.light_radiance(scene, cell_direction(u, t)));
+                        if l.is_finite() && l > 0.0 {
+                            sum += l as f64;
+                        }
+                    }
+                }
+                *out = (sum / (ss * ss) as f64) as f32;
+            }
+        });
+        let first = lum[0];
+        if lum.iter().all(|&l| l == first) {
+            env.integral = if first.is_finite() {
+                first * 4.0 * PI
+            } else {
+                0.0
+            };
+            return env;
+        }
+        let mut integral = 0.0f64;
+        let func: Vec<f32> = lum
+            .iter()
+            .enumerate()
+            .map(|(k, &l)| {
+                let t = ((k / w) as f32 + 0.5) / h as f32;
+                let f = l * (PI * t).sin();
+                integral += f as f64;
+                f
+            })
+            .collect();
+        env.integral =
+            (integral * 2.0 * std::f64::consts::PI * std::f64::consts::PI / (w * h) as f64) as f32;
+        env.dist = Distribution2D::new(w, h, func).map(Box::new);
+        if env.dist.is_none() {
+            env.integral = 0.0;
+        }
+        env
+    }
+
+    fn shade_env<'a>(&self, scene: &'a Scene) -> ShadeEnv<'a> {
+        ShadeEnv {
+            images: &scene.images,
+            textures: &scene.textures,
+            camera_to_world: self.camera_to_world,
+        }
+    }
+
+    /// The radiance arriving along `-d` from the world, for a ray along the unit direction
+    /// `d` (renderer world) leaving path vertex `depth - 1` with Light Path bits `flags`.
+    #[inline]
+    pub fn radiance(&self, scene: &Scene, d: Vec3, depth: u32, flags: u32) -> Vec3 {
+        let g = background_globals(d, depth, flags);
+        self.program.emission(&g, &self.shade_env(scene))
+    }
+
+    /// The radiance light sampling sees (no Light Path bits, as Cycles' light evaluation).
+    #[inline]
+    fn light_radiance(&self, scene: &Scene, d: Vec3) -> Vec3 {
+        self.radiance(scene, d, LIGHT_DEPTH, 0)
+    }
+
+    /// Solid-angle density of direction `d` (renderer world, unit).
+    #[inline]
+    pub fn pdf_dir(&self, d: Vec3) -> f32 {
+        let Some(dist) = &self.dist else {
+            return square_to_uniform_sphere_pdf();
+        };
+        let b = to_blender(d);
+        let sin_theta = (b.x * b.x + b.y * b.y).sqrt();
+        if sin_theta.is_nan() || sin_theta <= 0.0 {
+            return 0.0;
+        }
+        let uv = direction_to_equirectangular(b);
+        let p = dist.pdf(Vec2::new(uv.x, 1.0 - uv.y));
+        p / (2.0 * PI * PI * sin_theta)
+    }
+
+    /// The importance map, if the world has one.
+    pub fn distribution(&self) -> Option<&Distribution2D> {
+        self.dist.as_deref()
+    }
+}
+
+impl Emitter for Environment {
+    fn sample(&self, scene: &Scene, rec: &mut EmitterQueryRecord, u: Vec2) -> Vec3 {
+        rec.dist = f32::INFINITY;
+        rec.wi = match &self.dist {
+            Some(dist) => {
+                let (p, _) = dist.sample(u);
+                cell_direction(p.x, p.y)
+            }
+            None => square_to_uniform_sphere(u),
+        };
+        rec.pdf = self.pdf_dir(rec.wi);
+        if !(rec.pdf > 0.0 && rec.pdf.is_finite()) {
+            rec.pdf = 0.0;
+            return Vec3::ZERO;
+        }
+        self.light_radiance(scene, rec.wi) / rec.pdf
+    }
+
+    fn eval(&self, scene: &Scene, rec: &EmitterQueryRecord) -> Vec3 {
+        self.light_radiance(scene, rec.wi)
+    }
+
+    fn pdf(&self, _scene: &Scene, rec: &EmitterQueryRecord) -> f32 {
+        self.pdf_dir(rec.wi)
+    }
+
+    fn power(&self, _scene: &Scene, r: f32) -> f32 {
+        self.integral * PI * r * r
+    }
+
+    fn is_delta(&self) -> bool {
+        false
+    }
+}
+
+/// The emitter of `scene`'s world, if it is not black: the constant [`super::Background`] for
+/// a constant colour (no graph, or a graph that does not depend on the direction or the ray),
+/// else an [`Environment`]. A world graph that cannot be compiled falls back to the constant
+/// colour, with a warning; the compiler's fallbacks are reported naming the world.
+pub fn world_emitter(
+    scene: &Scene,
+    camera_to_world: Mat4,
+    warnings: &mut Vec<String>,
+) -> Option<super::EmitterInstance> {
+    let constant = |c: Vec3| {
+        (c.max_element() > 0.0 && c.is_finite()).then_some(super::EmitterInstance::Background(
+            super::Background { radiance: c },
+        ))
+    };
+    let world = &scene.world;
+    let Some(graph) = &world.graph else {
+        return constant(scene.background);
+    };
+    let name = &world.name;
+    let ours = |w: String| w.replacen(&format!("material '{name}'"), &format!("world '{name}'"), 1);
+    let compiled = match crate::shading::compile(graph, name) {
+        Ok(c) => c,
+        Err(e) => {
+            warnings.push(format!(
+                "{}; the world renders as its colour {:?}",
+                ours(e.0),
+                scene.background.to_array()
+            ));
+            return constant(scene.background);
+        }
+    };
+    for w in compiled.warnings {
+        let w = ours(w);
+        if !warnings.contains(&w) {
+            warnings.push(w);
+        }
+    }
+    let program = compiled.program;
+    if let Some(set) = &program.constant {
+        return constant(set.emission);
+    }
+    if !program.may_emit() {
+        return None;
+    }
+    let res = map_resolution(world, graph, &scene.images);
+    let env = Environment::new(scene, Arc::new(program), camera_to_world, res);
+    Some(super::EmitterInstance::Environment(env))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn distribution_samples_where_its_density_says() {
+        // One bright cell among dim ones: samples land in it in proportion.
+        let (w, h) = (8, 4);
+        let mut f = vec![1.0f32; w * h];
+        f[2 * w + 5] = 29.0;
+        let d = Distribution2D::new(w, h, f).unwrap();
+        let total = (w * h - 1) as f32 + 29.0;
+        let n = 64_000;
+        let mut hits = 0;
+        for k in 0..n {
+            // A stratified sweep of the unit square.
+            let u = Vec2::new(
+                ((k % 256) as f32 + 0.5) / 256.0,
+                ((k / 256) as f32 + 0.5) / 250.0,
+            );
+            let (p, pdf) = d.sample(u);
+            assert!(p.x >= 0.0 && p.x < 1.0 && p.y >= 0.0 && p.y < 1.0, "{p}");
+            assert!(
+                (pdf - d.pdf(p)).abs() <= 1e-6 * pdf.max(1.0),
+                "{pdf} vs {}",
+                d.pdf(p)
+            );
+            if (p.x * w as f32) as usize == 5 && (p.y * h as f32) as usize == 2 {
+                hits += 1;
+            }
+        }
+        let want = 29.0 / total;
+        let got = hits as f32 / n as f32;
+        assert!((got - want).abs() < 0.01, "{got} vs {want}");
+        // Density integrates to one.
+        let int: f32 = (0..w * h)
+            .map(|k| {
+                d.pdf(Vec2::new(
+                    ((k % w) as f32 + 0.5) / w as f32,
+                    ((k / w) as f32 + 0.5) / h as f32,
+                ))
+            })
+            .sum::<f32>()
+            / (w * h) as f32;
+        assert!((int - 1.0).abs() < 1e-5, "{int}");
+        // All-zero and non-finite maps have no distribution; empty cells are never sampled.
+        assert!(Distribution2D::new(2, 2, vec![0.0, f32::NAN, -1.0, 0.0]).is_none());
+        let d = Distribution2D::new(4, 1, vec![0.0, 1.0, 0.0, 1.0]).unwrap();
+        for k in 0..100 {
+            let (p, pdf) = d.sample(Vec2::new(k as f32 / 100.0, 0.5));
+            let cell = (p.x * 4.0) as usize;
+            assert!(cell == 1 || cell == 3, "{p}");
+            assert_eq!(pdf, 2.0);
+        }
+    }
+
+    #[test]
+    fn map_resolution_follows_the_image_capped() {
+        let img = |w: u32, h: u32| Image {
+            width: w,
+            height: h,
+            rgba8: Vec::new(),
+            float: vec![[0.0; 4]; 1],
+        };
+        let mut g = Graph::default();
+        let mut n = crate::shading::Node::new("ShaderNodeTexEnvironment");
+        n.image = Some(0);
+        g.add(n);
+        let world = World::default();
+        assert_eq!(
+            map_resolution(&world, &g, &[img(512, 256)]),
+            Some([512, 256, 1])
+        );
+        assert_eq!(
+            map_resolution(&world, &g, &[img(8192, 4096)]),
+            Some([2048, 1024, 4])
+        );
+        assert_eq!(map_resolution(&world, &g, &[img(1, 1)]), Some([64, 32, 1]));
+        assert_eq!(
+            map_resolution(&world, &g, &[img(100_000, 2)]),
+            Some([2048, 32, 4])
+        );
+        assert_eq!(
+            map_resolution(&world, &Graph::default(), &[]),
+            Some([1024, 512, 1])
+        );
+        let manual = World {
+            sampling: WorldSampling::Manual(256),
+            ..Default::default()
+        };
+        assert_eq!(
+            map_resolution(&manual, &g, &[img(512, 256)]),
+            Some([256, 128, 1])
+        );
+        let none = World {
+            sampling: WorldSampling::None,
+            ..Default::default()
+        };
+        assert_eq!(map_resolution(&none, &g, &[]), None);
+    }
+}

@@ -1,0 +1,261 @@
+"""Blender light parameters through the add-on (F12 path) against Cycles on the same scene:
+point and spot radius (soft falloff on, Blender's default, and off), spot blend, sun angle,
+area spread, lights seen by the camera and in mirrors, per-light ray visibility, and a room lit
+by a sun through a window with a camera-invisible area light in the way (lights never occlude).
+
+Criteria: each channel's global mean within 2%, 8x8 block means within 5% at the 95th
+percentile (imgcompare.compare), and shadow edges that agree locally (``edge_agreement``:
+along the reference's strongest edges, the blurred images within 5% and the edge gradients
+within 10% in the mean, so a penumbra of the wrong width or place fails). Needs the renderer
+binary (conftest.py's ``tesela_bin``).
+"""
+
+import math
+import os
+
+import bpy
+import numpy as np
+import pytest
+
+import imgcompare
+import scenes
+from test_addon import result_pixels
+from test_addon_cycles import addon  # noqa: F401  (the fixture)
+
+SIZE = 64
+
+
+def _blur(lum):
+    """3x3 box blur with edge replication."""
+    p = np.pad(lum, 1, mode="edge")
+    h, w = lum.shape
+    return sum(p[i:i + h, j:j + w] for i in range(3) for j in range(3)) / 9.0
+
+
+def edge_agreement(test, ref, fraction=0.12):
+    """Compare the images along the reference's strongest edges (shadow boundaries,
+    silhouettes): returns (median relative error of the blurred luminance there, ratio of the
+    mean gradient magnitudes test/ref there)."""
+    w = np.array([0.2126, 0.7152, 0.0722])
+    t = _blur(np.asarray(test)[..., :3] @ w)
+    r = _blur(np.asarray(ref)[..., :3] @ w)
+    gy, gx = np.gradient(r)
+    g_ref = np.hypot(gx, gy)
+    ty, tx = np.gradient(t)
+    g_test = np.hypot(tx, ty)
+    mask = g_ref >= np.quantile(g_ref, 1.0 - fraction)
+    floor = 0.05 * r.mean()
+    err = np.abs(t - r)[mask] / np.maximum(r[mask], floor)
+    return float(np.median(err)), float(g_test[mask].mean() / max(g_ref[mask].mean(), 1e-12))
+
+
+def _plane_with_box():
+    """A 6 m Lambertian plane (albedo 0.8) with a 0.6 m box at the origin, seen from close by,
+    from the front and above, so that the box's shadows fill much of the frame."""
+    scene = scenes.clear_scene()
+    scenes.add_quad("Plane", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
+                    scenes.lambert("Floor", (0.8, 0.8, 0.8)))
+    scenes.add_box("Box", (-0.3, -0.3, 0.0), (0.3, 0.3, 0.6), scenes.lambert("BoxMat", (0.5, 0.6, 0.7)))
+    scenes.add_camera((0.0, -2.6, 2.4), (0.0, 0.3, 0.0), fov=math.radians(55.0))
+    return scenes.SceneInfo(scene, "box_stage")
+
+
+def point_radius(soft):
+    def build():
+        info = _plane_with_box()
+        # Behind the box as the camera sees it: the soft shadow falls towards the camera.
+        ob = scenes.add_point_light("Point", (-0.2, 1.5, 1.5), 100.0, radius=0.35)
+        ob.data.use_soft_falloff = soft
+        return info
+    return build
+
+
+def spot_radius_blend():
+    info = _plane_with_box()
+    ob = scenes.add_spot_light("Spot", (0.2, -0.4, 2.2), (-0.3, 0.3, 0.0), 200.0,
+                               math.radians(60.0), blend=0.4, radius=0.3)
+    ob.data.use_soft_falloff = False
+    return info
+
+
+def spot_radius_soft():
+    info = _plane_with_box()
+    scenes.add_spot_light("Spot", (0.2, -0.4, 2.2), (-0.3, 0.3, 0.0), 200.0,
+                          math.radians(45.0), blend=0.15, radius=0.2)
+    return info
+
+
+def sun_angle():
+    """A 25° sun whose soft shadow of the box falls towards the camera."""
+    info = scenes.light_over_plane("sun", sun_strength=3.0)
+    bpy.data.lights["Sun"].angle = math.radians(25.0)
+    scenes._aim(bpy.data.objects["Sun"], direction=(0.5, -0.6, -1.0))
+    return info
+
+
+def _mirror_stage():
+    """A mirror floor and a diffuse back wall, seen from the front, slightly from above."""
+    scene = scenes.clear_scene()
+    scenes.add_quad("Mirror", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
+                    scenes.mirror("Chrome", (0.9, 0.9, 0.9)))
+    scenes.add_quad("Wall", [(-3, 2, 0), (3, 2, 0), (3, 2, 3), (-3, 2, 3)],
+                    scenes.lambert("Wall", (0.6, 0.6, 0.6)))
+    scenes.add_camera((0.0, -3.0, 1.2), (0.0, 0.5, 0.6), fov=math.radians(45.0))
+    return scenes.SceneInfo(scene, "mirror_stage")
+
+
+def lights_seen_in_a_mirror():
+    """A sphere light and a soft-falloff point light in view and reflected by the mirror floor,
+    and a rectangular area light facing the camera."""
+    info = _mirror_stage()
+    a = scenes.add_point_light("Ball", (-0.8, 0.5, 0.7), 40.0, radius=0.25)
+    a.data.use_soft_falloff = False
+    a.visible_camera = True
+    b = scenes.add_point_light("Disk", (0.7, 0.3, 1.0), 30.0, radius=0.18)
+    b.visible_camera = True
+    c = scenes.add_area_light("Panel", (0.0, 1.2, 1.6), (0.0, -3.0, 1.2), 60.0, 0.5)
+    c.data.shape = "RECTANGLE"
+    c.data.size_y = 0.25
+    c.visible_camera = True
+    return info
+
+
+def sun_in_a_mirror():
+    """A camera looking at the horizon over a mirror floor: a 10° sun 15° above the horizon in
+    front of it, seen directly (visible to the camera) and reflected, and a diffuse box it lights."""
+    scene = scenes.clear_scene()
+    scenes.add_quad("Mirror", [(-6, -6, 0), (6, -6, 0), (6, 6, 0), (-6, 6, 0)],
+                    scenes.mirror("Chrome", (0.9, 0.9, 0.9)))
+    scenes.add_box("Box", (-1.2, -0.5, 0.0), (-0.6, 0.1, 0.6), scenes.lambert("Box", (0.6, 0.5, 0.4)))
+    scenes.add_camera((0.0, -3.0, 0.6), (0.0, 0.0, 0.6), fov=math.radians(60.0))
+    e = math.radians(15.0)
+    ob = scenes.add_sun_light("Sun", (0.0, -math.cos(e), -math.sin(e)), 2.0,
+                              angle=math.radians(10.0))
+    ob.visible_camera = True
+    return scenes.SceneInfo(scene, "sun_in_a_mirror")
+
+
+def area_spread(shape, spread_deg):
+    def build():
+        info = _plane_with_box()
+        ob = scenes.add_area_light("Area", (0.3, -0.2, 1.5), (0.1, 0.1, 0.0), 150.0, 0.9)
+        ob.data.shape = shape
+        if shape in ("RECTANGLE", "ELLIPSE"):
+            ob.data.size_y = 0.5
+        ob.data.spread = math.radians(spread_deg)
+        return info
+    return build
+
+
+def visibility_flags():
+    """A glossy sphere and a diffuse box: a point light excluded from diffuse closures, an area
+    light excluded from glossy ones, and a sphere light that casts no shadow."""
+    info = _plane_with_box()
+    scenes.add_sphere("Ball", (0.7, 0.4, 0.5), 0.5,
+                      scenes.material("Gloss", (0.8, 0.8, 0.8), metallic=1.0, roughness=0.25))
+    p = scenes.add_point_light("NoDiffuse", (1.2, -1.0, 1.8), 80.0, radius=0.1)
+    p.visible_diffuse = False
+    a = scenes.add_area_light("NoGlossy", (-0.5, -0.8, 2.0), (0.0, 0.0, 0.0), 120.0, 0.8)
+    a.visible_glossy = False
+    s = scenes.add_point_light("NoShadow", (-0.6, 0.5, 1.3), 30.0, radius=0.15)
+    s.data.use_shadow = False
+    return info
+
+
+def sunlit_room():
+    """A closed 4 x 4 x 2.6 m room with a window in the -y wall: a sun shines through it onto the
+    floor, and a camera-invisible area light hangs in the sunbeam facing down. Lights do not
+    occlude, so the sun's patch on the floor has no dark blotch under the area light."""
+    scene = scenes.clear_scene()
+    white = scenes.lambert("White", (0.7, 0.7, 0.7))
+    x0, x1, y0, y1, h = -2.0, 2.0, -2.0, 2.0, 2.6
+    scenes.add_quad("Floor", [(x0, y0, 0), (x1, y0, 0), (x1, y1, 0), (x0, y1, 0)], white)
+    scenes.add_quad("Ceiling", [(x0, y0, h), (x0, y1, h), (x1, y1, h), (x1, y0, h)], white)
+    scenes.add_quad("Back", [(x0, y1, 0), (x1, y1, 0), (x1, y1, h), (x0, y1, h)], white)
+    scenes.add_quad("Left", [(x0, y0, 0), (x0, y1, 0), (x0, y1, h), (x0, y0, h)], white)
+    scenes.add_quad("Right", [(x1, y0, 0), (x1, y0, h), (x1, y1, h), (x1, y1, 0)], white)
+    # The front wall (y = y0, facing +y) with a 1.4 x 1 m window from z = 1.0 to 2.0.
+    wx, wz0, wz1 = 0.7, 1.0, 2.0
+    front = [[(x0, 0), (-wx, 0), (-wx, h), (x0, h)], [(wx, 0), (x1, 0), (x1, h), (wx, h)],
+             [(-wx, 0), (wx, 0), (wx, wz0), (-wx, wz0)], [(-wx, wz1), (wx, wz1), (wx, h), (-wx, h)]]
+    for i, q in enumerate(front):
+        scenes.add_quad(f"Front{i}", [(x, y0, z) for x, z in q][::-1], white)
+    scenes.add_sun_light("Sun", (0.0, 1.0, -0.8), 6.0, angle=math.radians(3.0))
+    a = scenes.add_area_light("Fill", (0.0, -0.9, 0.9), (0.0, -0.9, 0.0), 40.0, 0.6)
+    a.visible_camera = False
+    scenes.add_camera((1.6, 1.7, 1.8), (-0.2, -0.8, 0.3), fov=math.radians(70.0))
+    return scenes.SceneInfo(scene, "sunlit_room")
+
+
+# (id, builder, Cycles max_bounces, Tesela integrator, spp)
+CASES = [
+    ("point_radius_soft", point_radius(True), 0, "direct_mis", 512),
+    ("point_radius_sphere", point_radius(False), 0, "direct_mis", 512),
+    ("spot_radius_blend_sphere", spot_radius_blend, 0, "direct_mis", 512),
+    ("spot_radius_soft", spot_radius_soft, 0, "direct_mis", 512),
+    ("sun_angle", sun_angle, 0, "direct_mis", 512),
+    ("lights_in_a_mirror", lights_seen_in_a_mirror, 1, "path_mis", 512),
+    ("sun_in_a_mirror", sun_in_a_mirror, 1, "path_mis", 256),
+    ("area_square_spread60", area_spread("SQUARE", 60.0), 0, "direct_mis", 512),
+    ("area_rectangle_spread25", area_spread("RECTANGLE", 25.0), 0, "direct_mis", 512),
+    ("area_disk_spread90", area_spread("DISK", 90.0), 0, "direct_mis", 512),
+    ("area_square_spread0", area_spread("SQUARE", 0.0), 0, "direct_mis", 64),
+    ("visibility_flags", visibility_flags, 1, "path_mis", 1024),
+    ("sunlit_room", sunlit_room, 2, "path_mis", 1024),
+]
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
+def test_light_parameters_agree_with_cycles(addon, tesela_bin, tmp_path, monkeypatch, case):  # noqa: F811
+    name, build, bounces, integrator, spp = case
+    monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
+    info = build()
+    scene = info.scene
+    scenes.configure_cycles(scene, SIZE, SIZE, spp, bounces, seed=7)
+    ref = imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
+
+    scene.render.engine = "TESELA"
+    t = scene.tesela
+    t.integrator, t.samples, t.max_depth, t.seed = integrator, spp, bounces + 2, 1
+    t.threads = int(os.environ.get("TESELA_TEST_THREADS", "0"))
+    assert bpy.ops.render.render() == {"FINISHED"}
+    assert ref[..., :3].mean() > 0.01, "the Cycles reference is black: the scene is broken"
+    got = result_pixels(tmp_path)
+    result = imgcompare.compare(got, ref, mean_tol=0.02, block_tol=0.05)
+    edge_err, grad_ratio = edge_agreement(got, ref)
+    print(f"{name}: {result}; edges: blurred median err {edge_err:.4f}, "
+          f"gradient ratio {grad_ratio:.4f}")
+    assert result.ok, f"{name}: Tesela (add-on) vs Cycles: {result}"
+    assert edge_err <= 0.05, f"{name}: edges differ locally: median error {edge_err:.4f}"
+    assert abs(grad_ratio - 1.0) <= 0.10, f"{name}: edge gradients differ: ratio {grad_ratio:.4f}"
+
+
+def test_light_fields_are_exported(addon, tmp_path):  # noqa: F811
+    """TESELA_light carries every light parameter and the object's ray visibility."""
+    import json
+
+    scenes.clear_scene()
+    p = scenes.add_point_light("Ball", (0, 0, 1), 10.0, radius=0.2)
+    p.data.use_soft_falloff = False
+    p.data.use_shadow = False
+    p.visible_glossy = False
+    p.visible_camera = True
+    a = scenes.add_area_light("Panel", (0, 0, 2), (0, 0, 0), 20.0, 0.5)
+    a.data.spread = math.radians(40.0)
+    a.visible_diffuse = False
+    a.data.cycles.use_multiple_importance_sampling = False
+    s = scenes.add_sun_light("Sun", (0, 0, -1), 2.0, angle=math.radians(5.0))
+    s.visible_transmission = False
+    path = tmp_path / "l.gltf"
+    assert bpy.ops.export_scene.tesela_gltf(filepath=str(path)) == {"FINISHED"}
+    doc = json.loads(path.read_text(encoding="utf-8"))
+    lights = {n["name"]: n["extensions"]["TESELA_light"] for n in doc["nodes"]
+              if "TESELA_light" in n.get("extensions", {})}
+    ball, panel, sun = lights["Ball"], lights["Panel"], lights["Sun"]
+    assert ball["radius"] == pytest.approx(0.2) and ball["soft_falloff"] is False
+    assert ball["cast_shadow"] is False and ball["visible_glossy"] is False
+    assert ball["visible_camera"] is True and ball["visible_diffuse"] is True
+    assert panel["spread"] == pytest.approx(math.radians(40.0))
+    assert panel["visible_diffuse"] is False and panel["multiple_importance"] is False
+    assert panel["cast_shadow"] is True and panel["visible_camera"] is False
+    assert sun["angle"] == pytest.approx(math.radians(5.0)) and sun["visible_transmission"] is False

@@ -1,0 +1,579 @@
+"""Material scenes as artists build them, rendered by Tesela through the add-on (F12 path:
+``bpy.ops.render.render`` with engine TESELA, the add-on's graph export, the pipe) and by Cycles:
+one small lit scene per feature (packed roughness/metallic image through Separate Color, a
+tangent-space normal map under a grazing sun, bump from Noise, Mapping, Mix/Add shaders with Layer
+Weight and Fresnel, alpha cut-outs and Transparent mixes casting shadows, a Noise -> Color Ramp
+floor, vertex colours and a second UV map, textured emission lighting a room, Principled coat /
+sheen / subsurface, rough glass in front of a textured wall).
+
+Criteria (imgcompare.compare): per-channel means within 2%, 8x8-block relative errors within 5% at
+the 95th percentile, 64x64 images. Tesela's max depth = Cycles' max bounces + 2. Images are
+generated in code. ``test_broken_scene_fails`` shows the comparison can fail: it changes a node
+after Tesela has exported the scene and before Cycles renders it. Set ``TESELA_TEST_SAVE=DIR`` to
+write both images of every case as PNGs (sRGB) to DIR. Needs the renderer binary (conftest.py's
+``tesela_bin``).
+"""
+
+import math
+import os
+import sys
+from pathlib import Path
+
+import bpy
+import numpy as np
+import pytest
+
+import imgcompare
+import scenes
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent.parent
+if str(REPO) not in sys.path:
+    sys.path.insert(0, str(REPO))
+
+import blender_addon  # noqa: E402
+from blender_addon import engine as tesela_engine  # noqa: E402
+from test_addon import result_pixels  # noqa: E402
+
+SIZE = 64
+MEAN_TOL = 0.02
+BLOCK_TOL = 0.05
+
+
+@pytest.fixture(scope="module")
+def addon():
+    registered = tesela_engine.TeselaRenderEngine.is_registered
+    if not registered:
+        blender_addon.register()
+    yield
+    if not registered and tesela_engine.TeselaRenderEngine.is_registered:
+        blender_addon.unregister()
+
+
+# --------------------------------------------------------------------------------------------
+# building blocks
+
+
+def node_material(name):
+    """A material with an empty node tree but for its Material Output: (mat, node tree, output)."""
+    mat = bpy.data.materials.new(name)
+    if bpy.app.version < (5, 0, 0):
+        mat.use_nodes = True
+    nt = mat.node_tree
+    for n in list(nt.nodes):
+        nt.nodes.remove(n)
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    return mat, nt, out
+
+
+def node(nt, kind, props=None, **inputs):
+    """A node of ``kind``: ``props`` first, then inputs by name (``_`` for spaces): a socket
+    links, anything else is the default value."""
+    n = nt.nodes.new(kind)
+    for k, v in (props or {}).items():
+        setattr(n, k, v)
+    for k, v in inputs.items():
+        sock = n.inputs[k.replace("_", " ")]
+        if isinstance(v, bpy.types.NodeSocket):
+            nt.links.new(v, sock)
+        else:
+            sock.default_value = v
+    return n
+
+
+def surface(nt, out, sock):
+    nt.links.new(sock, out.inputs["Surface"])
+
+
+def principled(nt, out, **inputs):
+    """A Principled BSDF into the output; inputs by (5.x) name, ``_`` for spaces."""
+    n = node(nt, "ShaderNodeBsdfPrincipled", **inputs)
+    surface(nt, out, n.outputs[0])
+    return n
+
+
+def image(name, px, non_color=False, float_buffer=False):
+    """A generated image from (h, w, 4) float pixels, rows bottom to top (Blender's order)."""
+    h, w = px.shape[:2]
+    img = bpy.data.images.new(name, w, h, alpha=True, float_buffer=float_buffer)
+    img.colorspace_settings.name = "Non-Color" if non_color else (
+        "Linear Rec.709" if float_buffer else "sRGB")
+    img.pixels.foreach_set(np.ascontiguousarray(px, dtype=np.float32).ravel())
+    img.update()
+    img.pack()
+    return img
+
+
+def image_node(nt, img, vector=None, interpolation="Linear"):
+    n = node(nt, "ShaderNodeTexImage", {"image": img, "interpolation": interpolation})
+    if vector is not None:
+        nt.links.new(vector, n.inputs["Vector"])
+    return n
+
+
+def uv_quad(name, corners, mat, uv=((0, 0), (1, 0), (1, 1), (0, 1)), extra_uv=None):
+    """A quad with UV map "UVMap" (``uv`` per corner) and optionally a second map "UV2"."""
+    ob = scenes.add_quad(name, corners, mat)
+    layer = ob.data.uv_layers.new(name="UVMap")
+    layer.data.foreach_set("uv", [c for p in uv for c in p])
+    if extra_uv is not None:
+        layer2 = ob.data.uv_layers.new(name="UV2")
+        layer2.data.foreach_set("uv", [c for p in extra_uv for c in p])
+    ob.data.uv_layers.active = layer
+    layer.active_render = True
+    return ob
+
+
+def grid(name, n, half, mat, z=0.0):
+    """An n x n quad grid over [-half, half]^2 at height z, with UV map "UVMap" over [0, 1]^2."""
+    verts = [(-half + 2 * half * i / n, -half + 2 * half * j / n, z)
+             for j in range(n + 1) for i in range(n + 1)]
+    faces = [(j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1,
+              (j + 1) * (n + 1) + i) for j in range(n) for i in range(n)]
+    ob = scenes.add_mesh(name, verts, faces, mat)
+    layer = ob.data.uv_layers.new(name="UVMap")
+    uv = []
+    for f in ob.data.polygons:
+        for li in f.loop_indices:
+            v = ob.data.vertices[ob.data.loops[li].vertex_index].co
+            uv += [(v.x + half) / (2 * half), (v.y + half) / (2 * half)]
+    layer.data.foreach_set("uv", uv)
+    return ob
+
+
+def world(strength, color=(1.0, 1.0, 1.0)):
+    bg = next(n for n in bpy.context.scene.world.node_tree.nodes if n.type == "BACKGROUND")
+    bg.inputs["Color"].default_value = (*color, 1.0)
+    bg.inputs["Strength"].default_value = strength
+
+
+def lambert_mat(name, color):
+    return scenes.lambert(name, color)
+
+
+def checker_px(w=32, h=32, n=4, a=(0.8, 0.75, 0.6), b=(0.1, 0.2, 0.35)):
+    yy, xx = np.mgrid[0:h, 0:w]
+    on = ((xx * n // w + yy * n // h) % 2 == 0)[..., None]
+    px = np.ones((h, w, 4), dtype=np.float32)
+    px[..., :3] = np.where(on, np.array(a), np.array(b))
+    # a gradient across the image so that orientation and scale errors show
+    px[..., 0] *= 0.5 + 0.5 * xx / (w - 1)
+    return px
+
+
+# --------------------------------------------------------------------------------------------
+# the scenes (each builds the whole current scene)
+
+
+def _floor_stage(mat, sun_dir=(-0.4, 0.3, -1.0), sun=3.0, world_strength=0.2, half=2.0,
+                 camera=((0.0, -3.2, 2.6), (0.0, 0.0, 0.0)), fov=45.0, uv_repeat=1.0):
+    r = uv_repeat
+    ob = uv_quad("Floor", [(-half, -half, 0), (half, -half, 0), (half, half, 0), (-half, half, 0)],
+                 mat, uv=((0, 0), (r, 0), (r, r), (0, r)))
+    if sun:
+        scenes.add_sun_light("Sun", sun_dir, sun)
+    world(world_strength)
+    scenes.add_camera(camera[0], camera[1], fov=math.radians(fov))
+    return ob
+
+
+def packed_rough_metal():
+    """One packed image: R = roughness, G = metallic (Non-Color), through Separate Color into a
+    Principled BSDF, on a floor lit by a sun and a grey world (the metal reflects the world)."""
+    h = w = 32
+    yy, xx = np.mgrid[0:h, 0:w]
+    px = np.ones((h, w, 4), dtype=np.float32)
+    px[..., 0] = 0.05 + 0.9 * xx / (w - 1)                           # roughness ramp
+    px[..., 1] = ((xx // 8 + yy // 8) % 2).astype(np.float32)        # metal squares
+    px[..., 2] = 0.5
+    img = image("Packed", px, non_color=True)
+    mat, nt, out = node_material("RoughMetal")
+    tex = image_node(nt, img)
+    sep = node(nt, "ShaderNodeSeparateColor", Color=tex.outputs["Color"])
+    principled(nt, out, Base_Color=(0.8, 0.55, 0.3, 1.0), Roughness=sep.outputs["Red"],
+               Metallic=sep.outputs["Green"])
+    _floor_stage(mat, sun_dir=(0.2, 0.6, -1.0), world_strength=0.5)
+
+
+def bumpy_normal_px(n=64, k=4, amp=0.08):
+    """A tangent-space normal map of the height field amp·sin(2πku)·sin(2πkv) (encoded 0..1;
+    amp 0.08: slopes up to 2, normals tilted up to 63 degrees)."""
+    yy, xx = np.mgrid[0:n, 0:n]
+    u, v = (xx + 0.5) / n, (yy + 0.5) / n
+    f = 2 * math.pi * k
+    dx = amp * f * np.cos(f * u) * np.sin(f * v)
+    dy = amp * f * np.sin(f * u) * np.cos(f * v)
+    nrm = np.stack([-dx, -dy, np.ones_like(dx)], axis=-1)
+    nrm /= np.linalg.norm(nrm, axis=-1, keepdims=True)
+    px = np.ones((n, n, 4), dtype=np.float32)
+    px[..., :3] = nrm * 0.5 + 0.5
+    return px
+
+
+def normal_map(amp=0.08, sun_dir=(-1.0, 0.3, -0.27), specular=0.5):
+    """A tangent-space Normal Map (bumpy generated image) on a rough Principled floor (specular
+    0: Lambertian), lit by a sun (default: 15 degrees above the horizon)."""
+    img = image("Bumps", bumpy_normal_px(amp=amp), non_color=True)
+    mat, nt, out = node_material("NormalMapped")
+    tex = image_node(nt, img)
+    nm = node(nt, "ShaderNodeNormalMap", {"space": "TANGENT", "uv_map": "UVMap"},
+              Strength=1.0, Color=tex.outputs["Color"])
+    principled(nt, out, Base_Color=(0.7, 0.7, 0.7, 1.0), Roughness=0.6,
+               Specular_IOR_Level=specular, Normal=nm.outputs["Normal"])
+    _floor_stage(mat, sun_dir=sun_dir, sun=5.0, world_strength=0.05,
+                 camera=((0.0, -2.2, 2.4), (0.0, 0.0, 0.0)))
+
+
+def noise_bump():
+    """Bump (strength 0.8) from a Noise texture's Fac into a Principled BSDF, grazing sun."""
+    mat, nt, out = node_material("NoiseBump")
+    tc = node(nt, "ShaderNodeTexCoord")
+    noise = node(nt, "ShaderNodeTexNoise", Vector=tc.outputs["Object"], Scale=3.0, Detail=2.0)
+    bump = node(nt, "ShaderNodeBump", Strength=0.8, Distance=0.2, Height=noise.outputs["Fac"])
+    principled(nt, out, Base_Color=(0.6, 0.5, 0.4, 1.0), Roughness=0.5,
+               Normal=bump.outputs["Normal"])
+    _floor_stage(mat, sun_dir=(-1.0, 0.4, -0.35), sun=5.0, world_strength=0.05)
+
+
+def mapping_image():
+    """UV -> Mapping (scale (2, 3), rotation 30 degrees about Z, a location offset) -> Image
+    Texture -> Diffuse colour."""
+    img = image("Checker", checker_px())
+    mat, nt, out = node_material("Mapped")
+    tc = node(nt, "ShaderNodeTexCoord")
+    mp = node(nt, "ShaderNodeMapping", {"vector_type": "POINT"}, Vector=tc.outputs["UV"],
+              Location=(0.1, 0.2, 0.0), Rotation=(0.0, 0.0, math.radians(30.0)),
+              Scale=(2.0, 3.0, 1.0))
+    tex = image_node(nt, img, mp.outputs["Vector"])
+    principled(nt, out, Base_Color=tex.outputs["Color"], Roughness=1.0, Specular_IOR_Level=0.0)
+    _floor_stage(mat, camera=((0.0, 0.0, 5.0), (0.0, 0.0, 0.0)), fov=44.0)
+
+
+def _sphere_stage(mat, floor=(0.5, 0.5, 0.5), world_strength=0.3, sun=3.0,
+                  sun_dir=(-0.5, 0.6, -0.8)):
+    scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
+                    lambert_mat("Floor", floor))
+    scenes.add_sphere("Ball", (0.0, 0.0, 0.6), 0.6, mat, segments=64, rings=32)
+    scenes.add_sun_light("Sun", sun_dir, sun)
+    world(world_strength)
+    scenes.add_camera((0.0, -2.6, 1.5), (0.0, 0.0, 0.55), fov=math.radians(40.0))
+
+
+def mix_layer_weight():
+    """Mix Shader of Diffuse (fac 0) and Glossy (fac 1) by Layer Weight's Facing (blend 0.4)."""
+    mat, nt, out = node_material("LayerMix")
+    lw = node(nt, "ShaderNodeLayerWeight", Blend=0.4)
+    dif = node(nt, "ShaderNodeBsdfDiffuse", Color=(0.7, 0.2, 0.1, 1.0))
+    glo = node(nt, "ShaderNodeBsdfAnisotropic", Color=(0.9, 0.9, 0.9, 1.0), Roughness=0.25)
+    mix = node(nt, "ShaderNodeMixShader", Fac=lw.outputs["Facing"])
+    nt.links.new(dif.outputs[0], mix.inputs[1])
+    nt.links.new(glo.outputs[0], mix.inputs[2])
+    surface(nt, out, mix.outputs[0])
+    _sphere_stage(mat)
+
+
+def add_fresnel():
+    """Add Shader: Diffuse + Glossy whose colour is Fresnel (IOR 1.45)."""
+    mat, nt, out = node_material("AddFresnel")
+    fr = node(nt, "ShaderNodeFresnel", IOR=1.45)
+    dif = node(nt, "ShaderNodeBsdfDiffuse", Color=(0.1, 0.3, 0.6, 1.0))
+    glo = node(nt, "ShaderNodeBsdfAnisotropic", Color=fr.outputs["Fac"], Roughness=0.2)
+    add = node(nt, "ShaderNodeAddShader")
+    nt.links.new(dif.outputs[0], add.inputs[0])
+    nt.links.new(glo.outputs[0], add.inputs[1])
+    surface(nt, out, add.outputs[0])
+    _sphere_stage(mat)
+
+
+def _card_stage(card_mat):
+    """An upright 1.2 m card (UV over [0, 1]^2) on a floor, a sun behind-left casting its shadow
+    towards the camera."""
+    scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
+                    lambert_mat("Floor", (0.8, 0.8, 0.8)))
+    uv_quad("Card", [(-0.6, 0.3, 0.1), (0.6, 0.3, 0.1), (0.6, 0.3, 1.3), (-0.6, 0.3, 1.3)],
+            card_mat)
+    scenes.add_sun_light("Sun", (0.3, -0.8, -0.6), 3.0)
+    world(0.1)
+    scenes.add_camera((0.6, -3.0, 2.2), (0.0, 0.0, 0.4), fov=math.radians(45.0))
+
+
+def alpha_cutout():
+    """An image with a transparent round hole, Alpha into Principled Alpha."""
+    n = 32
+    yy, xx = np.mgrid[0:n, 0:n]
+    px = np.ones((n, n, 4), dtype=np.float32)
+    px[..., :3] = checker_px(n, n)[..., :3]
+    r = np.hypot((xx + 0.5) / n - 0.45, (yy + 0.5) / n - 0.55)
+    px[..., 3] = np.where(r < 0.28, 0.0, 1.0)
+    img = image("Holed", px)
+    mat, nt, out = node_material("Cutout")
+    tex = image_node(nt, img)
+    principled(nt, out, Base_Color=tex.outputs["Color"], Alpha=tex.outputs["Alpha"],
+               Roughness=0.8)
+    _card_stage(mat)
+
+
+def transparent_mix():
+    """Mix Shader: Transparent BSDF (tinted) and Diffuse at fac 0.4 (40% diffuse)."""
+    mat, nt, out = node_material("HalfTransparent")
+    tr = node(nt, "ShaderNodeBsdfTransparent", Color=(0.9, 0.6, 0.3, 1.0))
+    dif = node(nt, "ShaderNodeBsdfDiffuse", Color=(0.2, 0.5, 0.8, 1.0))
+    mix = node(nt, "ShaderNodeMixShader", Fac=0.4)
+    nt.links.new(tr.outputs[0], mix.inputs[1])
+    nt.links.new(dif.outputs[0], mix.inputs[2])
+    surface(nt, out, mix.outputs[0])
+    _card_stage(mat)
+
+
+def noise_ramp_floor(shader="principled"):
+    """Noise (Object coordinates) -> Color Ramp (three stops, linear) -> the base colour of a
+    Principled BSDF (roughness 0.9), or the colour of a Diffuse BSDF."""
+    mat, nt, out = node_material("RampFloor")
+    tc = node(nt, "ShaderNodeTexCoord")
+    noise = node(nt, "ShaderNodeTexNoise", Vector=tc.outputs["Object"], Scale=2.0, Detail=3.0)
+    ramp = node(nt, "ShaderNodeValToRGB", Fac=noise.outputs["Fac"])
+    el = ramp.color_ramp.elements
+    el[0].position, el[0].color = 0.35, (0.05, 0.1, 0.4, 1.0)
+    el[1].position, el[1].color = 0.65, (0.9, 0.8, 0.2, 1.0)
+    mid = el.new(0.5)
+    mid.color = (0.8, 0.1, 0.1, 1.0)
+    if shader == "principled":
+        principled(nt, out, Base_Color=ramp.outputs["Color"], Roughness=0.9)
+    else:
+        d = node(nt, "ShaderNodeBsdfDiffuse", Color=ramp.outputs["Color"])
+        surface(nt, out, d.outputs[0])
+    _floor_stage(mat, camera=((0.0, 0.0, 5.0), (0.0, 0.0, 0.0)), fov=44.0)
+
+
+def vertex_colour_uv2():
+    """A 4x4 grid with a colour attribute "Col" (per corner) multiplied by an image read through a
+    second UV map "UV2" (rotated, repeated), UVMap being the active one."""
+    mat, nt, out = node_material("VcolUV2")
+    ob = grid("Floor", 4, 2.0, mat)
+    mesh = ob.data
+    attr = mesh.color_attributes.new("Col", "FLOAT_COLOR", "CORNER")
+    cols = []
+    for li in range(len(mesh.loops)):
+        v = mesh.vertices[mesh.loops[li].vertex_index].co
+        cols += [0.2 + 0.2 * (v.x + 2), 0.9 - 0.2 * (v.y + 2), 0.3 + 0.1 * abs(v.x * v.y), 1.0]
+    attr.data.foreach_set("color", cols)
+    uv2 = mesh.uv_layers.new(name="UV2")
+    uv = []
+    for li in range(len(mesh.loops)):
+        v = mesh.vertices[mesh.loops[li].vertex_index].co
+        uv += [0.6 * v.y + 0.3, -0.6 * v.x + 0.1]
+    uv2.data.foreach_set("uv", uv)
+    mesh.uv_layers.active = mesh.uv_layers["UVMap"]
+    mesh.uv_layers["UVMap"].active_render = True
+    img = image("Checker2", checker_px(a=(0.9, 0.9, 0.9), b=(0.3, 0.3, 0.3)))
+    uvn = node(nt, "ShaderNodeUVMap", {"uv_map": "UV2"})
+    tex = image_node(nt, img, uvn.outputs["UV"])
+    vc = node(nt, "ShaderNodeVertexColor", {"layer_name": "Col"})
+    mix = node(nt, "ShaderNodeMix", {"data_type": "RGBA", "blend_type": "MULTIPLY"})
+    mix.inputs["Factor"].default_value = 1.0
+    nt.links.new(vc.outputs["Color"], mix.inputs[6])
+    nt.links.new(tex.outputs["Color"], mix.inputs[7])
+    principled(nt, out, Base_Color=mix.outputs[2], Roughness=1.0, Specular_IOR_Level=0.0)
+    scenes.add_sun_light("Sun", (-0.4, 0.3, -1.0), 3.0)
+    world(0.1)
+    scenes.add_camera((0.0, 0.0, 5.0), (0.0, 0.0, 0.0), fov=math.radians(44.0))
+
+
+def emission_room():
+    """A closed 2 m room (Lambertian walls, camera inside) lit only by a panel on the ceiling whose
+    Emission colour is an image texture."""
+    white = lambert_mat("White", (0.7, 0.7, 0.7))
+    red = lambert_mat("Red", (0.6, 0.1, 0.08))
+    scenes.add_quad("Floor", [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], white)
+    scenes.add_quad("Ceiling", [(-1, -1, 2), (-1, 1, 2), (1, 1, 2), (1, -1, 2)], white)
+    scenes.add_quad("Back", [(-1, 1, 0), (1, 1, 0), (1, 1, 2), (-1, 1, 2)], white)
+    scenes.add_quad("Front", [(-1, -1, 0), (-1, -1, 2), (1, -1, 2), (1, -1, 0)], white)
+    scenes.add_quad("Left", [(-1, -1, 0), (-1, 1, 0), (-1, 1, 2), (-1, -1, 2)], red)
+    scenes.add_quad("Right", [(1, -1, 0), (1, -1, 2), (1, 1, 2), (1, 1, 0)], white)
+    scenes.add_box("Block", (-0.1, 0.0, 0.0), (0.5, 0.6, 0.7), lambert_mat("Blk", (0.5, 0.6, 0.4)))
+    px = checker_px(16, 16, 2, a=(1.0, 0.9, 0.7), b=(0.2, 0.5, 1.0))
+    img = image("Panel", px)
+    mat, nt, out = node_material("Panel")
+    tex = image_node(nt, img)
+    em = node(nt, "ShaderNodeEmission", Color=tex.outputs["Color"], Strength=12.0)
+    surface(nt, out, em.outputs[0])
+    uv_quad("Panel", [(-0.5, -0.5, 1.99), (-0.5, 0.5, 1.99), (0.5, 0.5, 1.99), (0.5, -0.5, 1.99)],
+            mat)
+    scenes.add_camera((0.0, -0.95, 1.0), (0.0, 1.0, 0.9), fov=math.radians(80.0))
+
+
+def principled_variant(kind):
+    def build():
+        mat, nt, out = node_material("P_" + kind)
+        ins = dict(Base_Color=(0.7, 0.15, 0.1, 1.0), Roughness=0.5)
+        if kind == "coat":
+            ins.update(Coat_Weight=1.0, Coat_Roughness=0.05, Coat_IOR=1.5,
+                       Coat_Tint=(0.8, 0.9, 1.0, 1.0))
+        elif kind == "sheen":
+            ins.update(Base_Color=(0.1, 0.1, 0.3, 1.0), Sheen_Weight=1.0, Sheen_Roughness=0.3,
+                       Sheen_Tint=(1.0, 0.8, 0.6, 1.0))
+        elif kind == "subsurface":
+            ins.update(Base_Color=(0.8, 0.6, 0.5, 1.0), Subsurface_Weight=1.0,
+                       Subsurface_Radius=(1.0, 0.4, 0.2), Subsurface_Scale=0.05)
+        principled(nt, out, **ins)
+        _sphere_stage(mat)
+    return build
+
+
+def rough_glass():
+    """A 1.2 x 1.2 x 0.05 m Glass BSDF slab (roughness 0.3, GGX) 0.4 m in front of a textured
+    wall, under a white world."""
+    wall_img = image("WallTex", checker_px(32, 32, 8))
+    wmat, wnt, wout = node_material("Wall")
+    tex = image_node(wnt, wall_img)
+    principled(wnt, wout, Base_Color=tex.outputs["Color"], Roughness=1.0, Specular_IOR_Level=0.0)
+    uv_quad("Wall", [(-2, 1, -1), (2, 1, -1), (2, 1, 3), (-2, 1, 3)], wmat)
+    gmat, gnt, gout = node_material("RoughGlass")
+    g = node(gnt, "ShaderNodeBsdfGlass", {"distribution": "GGX"}, Color=(1, 1, 1, 1),
+             Roughness=0.3, IOR=1.5)
+    surface(gnt, gout, g.outputs[0])
+    scenes.add_box("Pane", (-0.6, 0.55, 0.4), (0.6, 0.6, 1.6), gmat)
+    # Lit by the world alone: a sun would light the wall through the rough glass (a caustic) and
+    # reach rays inside the pane through its faces, both very noisy in both renderers.
+    world(1.0)
+    scenes.add_camera((0.0, -2.5, 1.0), (0.0, 1.0, 1.0), fov=math.radians(40.0))
+
+
+# --------------------------------------------------------------------------------------------
+# the cases
+
+SSS_REASON = ("approximation: Tesela renders Principled subsurface as diffuse (no random walk); "
+              "measured: means ratio [0.999, 1.015, 1.021], block p95 0.069 (the lit side of the "
+              "ball up to 6% brighter in Tesela, blue channel)")
+
+NORMAL_MAP_REASON = (
+    "diffuse shading with strongly tilted normal-map normals (up to 63 degrees) under a sun 15 "
+    "degrees above the horizon: Tesela 1.40x Cycles (means 0.3337 vs 0.2391, block p95 0.686). "
+    "The Normal Map node's output itself agrees (Emission of N*0.5+0.5: 1e-4). Cycles' Diffuse "
+    "with that normal is 0.66x the plain cosine law max(0, N.L) (0.91x of the cosine times "
+    "Chiang et al.'s bump shadowing term, Cycles' bump_shadowing_term), Tesela's 1.02x the "
+    "cosine law, and Tesela lights pixels where N.L <= 0 (mean 0.048 where Cycles is 0). Tesela "
+    "has no bump shadowing term")
+
+NORMAL_MAP_SPECULAR_REASON = (
+    "Principled (specular 0.5, roughness 0.6) with gentle normal-map normals (tilt <= 14 deg), "
+    "sun 72 deg high, floor seen at grazing angles far off: Tesela 10% darker in the far blocks "
+    "(means 0.8944 vs 0.9018, block p95 0.096; sun only: p95 0.158). Agreeing with the same "
+    "normals: Diffuse BSDF / Principled specular 0 (0.1%, p95 0.002), Glossy BSDF (0.8%, p95 "
+    "0.013), world-only light (1.3%, p95 0.018); without the normal map Principled agrees (0.1%). "
+    "So the Principled specular layering under a delta light with perturbed normals facing "
+    "away from the viewer differs; likely Cycles' ensure_valid_specular_reflection of the "
+    "Principled's normal (kernel/svm/closure.h), which Tesela does not apply")
+
+RAMP_REASON = (
+    "Principled BSDF at roughness 0.9 (dielectric specular 0.5 over diffuse) is too dark in "
+    "Tesela: means ratio [0.985, 0.993, 0.969]. With a constant base colour 0.8: 0.814 vs "
+    "0.833 (-2.2%; -0.3% at roughness 0.5, -0.13% at 0.2); the specular lobe alone (black "
+    "base) -5.6% (0.02046 vs 0.02167), so most of the loss is the diffuse under the specular "
+    "layer (Tesela takes more energy off it at high roughness). The Color Ramp is exact (as "
+    "Emission: 2e-4; into a Diffuse BSDF: the case below passes)")
+
+# (id, builder, Cycles max_bounces, Cycles spp, Tesela spp)
+CASES = [
+    ("packed_roughness_metallic", packed_rough_metal, 0, 256, 1024),
+    ("normal_map_gentle_lambert", lambda: normal_map(0.02, (-0.3, 0.2, -1.0), 0.0), 0, 128, 512),
+    pytest.param(("normal_map_gentle_principled", lambda: normal_map(0.02, (-0.3, 0.2, -1.0)),
+                  0, 128, 512),
+                 marks=pytest.mark.xfail(reason=NORMAL_MAP_SPECULAR_REASON, strict=True)),
+    pytest.param(("normal_map_grazing_sun", normal_map, 0, 128, 512),
+                 marks=pytest.mark.xfail(reason=NORMAL_MAP_REASON, strict=True)),
+    # Passes, but Tesela is a systematic +1.4% brighter (Lambertian floor: +1.4%; without the
+    # bump +0.26%): Cycles' bump shadowing term darkens bumped diffuse under a grazing sun.
+    ("noise_bump", noise_bump, 0, 128, 512),
+    ("mapping_scale_rotation", mapping_image, 0, 64, 256),
+    ("mix_diffuse_glossy_layer_weight", mix_layer_weight, 0, 256, 1024),
+    ("add_diffuse_glossy_fresnel", add_fresnel, 0, 256, 1024),
+    ("alpha_cutout_shadow", alpha_cutout, 0, 128, 512),
+    ("transparent_mix_shadow", transparent_mix, 0, 128, 512),
+    pytest.param(("noise_color_ramp_floor", noise_ramp_floor, 0, 64, 256),
+                 marks=pytest.mark.xfail(reason=RAMP_REASON, strict=True)),
+    ("noise_color_ramp_diffuse", lambda: noise_ramp_floor("diffuse"), 0, 64, 256),
+    ("vertex_colour_second_uv", vertex_colour_uv2, 0, 64, 256),
+    ("emission_image_room", emission_room, 3, 256, 2048),
+    ("principled_coat", principled_variant("coat"), 0, 256, 1024),
+    ("principled_sheen", principled_variant("sheen"), 0, 256, 1024),
+    pytest.param(("principled_subsurface", principled_variant("subsurface"), 2, 256, 1024),
+                 marks=pytest.mark.xfail(reason=SSS_REASON, strict=False)),
+    ("rough_glass_textured_wall", rough_glass, 4, 256, 1024),
+]
+
+
+def _case_id(c):
+    return (c.values[0] if hasattr(c, "values") else c)[0]
+
+
+def _save_png(arr, path):
+    """Write a linear float (h, w, 4) array (rows top to bottom) as an sRGB PNG."""
+    h, w = arr.shape[:2]
+    img = bpy.data.images.new(path.stem, w, h, alpha=True, float_buffer=True)
+    try:
+        img.pixels.foreach_set(np.ascontiguousarray(arr[::-1], dtype=np.float32).ravel())
+        img.filepath_raw = str(path)
+        img.file_format = "PNG"
+        img.save()
+    finally:
+        bpy.data.images.remove(img)
+
+
+def _save(name, got, ref):
+    out = os.environ.get("TESELA_TEST_SAVE")
+    if not out:
+        return
+    d = Path(out)
+    d.mkdir(parents=True, exist_ok=True)
+    _save_png(got, d / f"{name}-tesela.png")
+    _save_png(ref, d / f"{name}-cycles.png")
+    np.save(d / f"{name}-tesela.npy", got)
+    np.save(d / f"{name}-cycles.npy", ref)
+
+
+def render_cycles(tmp_path, bounces, spp):
+    scene = bpy.context.scene
+    scenes.configure_cycles(scene, SIZE, SIZE, spp, bounces, seed=7)
+    return imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
+
+
+def render_tesela(tmp_path, bounces, spp):
+    scene = bpy.context.scene
+    scenes.configure_cycles(scene, SIZE, SIZE, 1, bounces, seed=7)  # resolution etc.
+    scene.render.engine = "TESELA"
+    t = scene.tesela
+    t.integrator, t.samples, t.max_depth, t.seed = "path_mis", spp, bounces + 2, 1
+    t.threads = int(os.environ.get("TESELA_TEST_THREADS", "0"))
+    assert bpy.ops.render.render() == {"FINISHED"}
+    return result_pixels(tmp_path)
+
+
+@pytest.mark.parametrize("case", CASES, ids=[_case_id(c) for c in CASES])
+def test_material_scene_agrees_with_cycles(addon, tesela_bin, tmp_path, monkeypatch, case):
+    name, build, bounces, cycles_spp, tesela_spp = case
+    monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
+    scenes.clear_scene()
+    build()
+    ref = render_cycles(tmp_path, bounces, cycles_spp)
+    assert ref[..., :3].mean() > 0.01, "the Cycles reference is black: the scene is broken"
+    got = render_tesela(tmp_path, bounces, tesela_spp)
+    _save(name, got, ref)
+    result = imgcompare.compare(got, ref, mean_tol=MEAN_TOL, block_tol=BLOCK_TOL)
+    print(f"{name}: {result}")
+    assert result.ok, f"{name}: Tesela (add-on) vs Cycles: {result}"
+
+
+def test_broken_scene_fails(addon, tesela_bin, tmp_path, monkeypatch):
+    """The comparison can fail: Tesela renders the Mapping scene, then the Mapping node's rotation
+    changes (30 -> 40 degrees) before Cycles renders it; the images must then disagree."""
+    monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
+    scenes.clear_scene()
+    mapping_image()
+    got = render_tesela(tmp_path, 0, 256)
+    mp = next(n for n in bpy.data.materials["Mapped"].node_tree.nodes if n.type == "MAPPING")
+    mp.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(40.0))
+    ref = render_cycles(tmp_path, 0, 64)
+    result = imgcompare.compare(got, ref, mean_tol=MEAN_TOL, block_tol=BLOCK_TOL)
+    print(f"broken mapping: {result}")
+    assert not result.ok, f"a 10-degree rotation change went unnoticed: {result}"
