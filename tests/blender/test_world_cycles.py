@@ -207,12 +207,13 @@ def _case_id(c):
     return (c.values[0] if hasattr(c, "values") else c)[0]
 
 
-# Measured in the final integrated build: every HDRI/backdrop case is 0.7-1.3% dark (mirror ball
-# 2.7% bright) with 8x8-block p95 around 0.12, against 0.23%/0.035 before the light and BSDF work
-# was merged; the gradient world still agrees. Kept visible until the cause is found.
+# Order-dependent: run alone, every case agrees (7/7 within 2% / 5%); run after the rest of
+# tests/blender in one process, the HDRI cases come out 0.7-2.7% off with 8x8-block p95 ~0.12,
+# so some state left behind by an earlier test changes one of the two renders. Kept visible
+# (non-strict) until that state is found.
 WORLD_REGRESSION = pytest.mark.xfail(
     strict=False,
-    reason="HDRI worlds regressed after the lights/BSDF merge: means 0.7-2.7% off, block p95 ~0.12")
+    reason="order-dependent: agrees alone, 0.7-2.7% off after the other test files (leaked state)")
 
 
 @WORLD_REGRESSION
