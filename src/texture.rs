@@ -5,11 +5,11 @@
 
 use crate::scene::{Image, Texture, Wrap};
 use glam::{Vec2, Vec4};
-use std::sync::OnceLock;
 
 /// sRGB transfer function decode table for 8-bit values.
+#[cfg(test)]
 fn srgb_table() -> &'static [f32; 256] {
-    static TABLE: OnceLock<[f32; 256]> = OnceLock::new();
+    static TABLE: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
     TABLE.get_or_init(|| {
         let mut t = [0.0; 256];
         for (i, v) in t.iter_mut().enumerate() {
@@ -24,8 +24,9 @@ fn srgb_table() -> &'static [f32; 256] {
     })
 }
 
+/// Texel index `i` wrapped into `0..n` by `mode`.
 #[inline]
-fn wrap(i: i64, n: u32, mode: Wrap) -> usize {
+pub fn wrap(i: i64, n: u32, mode: Wrap) -> usize {
     let n = n as i64;
     let r = match mode {
         Wrap::Repeat => i.rem_euclid(n),
@@ -72,8 +73,9 @@ fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
+/// sRGB decode of a filtered, encoded colour when `srgb` (alpha unchanged).
 #[inline]
-fn decode(v: Vec4, srgb: bool) -> Vec4 {
+pub fn decode(v: Vec4, srgb: bool) -> Vec4 {
     if srgb {
         Vec4::new(
             srgb_to_linear(v.x),
@@ -86,61 +88,58 @@ fn decode(v: Vec4, srgb: bool) -> Vec4 {
     }
 }
 
+/// Closest or bilinear filtering at glTF `uv` of an image of `width × height` texels whose
+/// texel `(x, y)` (integer coordinates before any wrapping) is `fetch(x, y)`. The one filter
+/// every image lookup uses; `fetch` decides wrapping, clipping and the texel's encoding.
+#[inline]
+pub fn filter(
+    width: u32,
+    height: u32,
+    nearest: bool,
+    uv: Vec2,
+    fetch: impl Fn(i64, i64) -> Vec4,
+) -> Vec4 {
+    let x = uv.x as f64 * width as f64 - 0.5;
+    let y = uv.y as f64 * height as f64 - 0.5;
+    // Keep coordinates in a range where i64 conversion is exact.
+    let x = x.clamp(-1e9, 1e9);
+    let y = y.clamp(-1e9, 1e9);
+    if nearest {
+        return fetch((x + 0.5).floor() as i64, (y + 0.5).floor() as i64);
+    }
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
+    let (x0, y0) = (x0 as i64, y0 as i64);
+    let top = fetch(x0, y0).lerp(fetch(x0 + 1, y0), fx);
+    let bottom = fetch(x0, y0 + 1).lerp(fetch(x0 + 1, y0 + 1), fx);
+    top.lerp(bottom, fy)
+}
+
 /// Looks up `tex` (whose image is `img`) at `uv`. `srgb` decodes colour data to linear.
 pub fn lookup(tex: &Texture, img: &Image, uv: Vec2, srgb: bool) -> Vec4 {
     if img.width == 0 || img.height == 0 || !uv.is_finite() {
         return Vec4::ONE;
     }
-    let x = uv.x as f64 * img.width as f64 - 0.5;
-    let y = uv.y as f64 * img.height as f64 - 0.5;
-    // Keep coordinates in a range where i64 conversion is exact.
-    let x = x.clamp(-1e9, 1e9);
-    let y = y.clamp(-1e9, 1e9);
+    let at = |x: i64, y: i64| {
+        (
+            wrap(x, img.width, tex.wrap_s),
+            wrap(y, img.height, tex.wrap_t),
+        )
+    };
     if !img.float.is_empty() {
-        if tex.nearest {
-            let xi = wrap((x + 0.5).floor() as i64, img.width, tex.wrap_s);
-            let yi = wrap((y + 0.5).floor() as i64, img.height, tex.wrap_t);
-            return texel_f(img, xi, yi, srgb);
-        }
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
-        let (x0, y0) = (x0 as i64, y0 as i64);
-        let xa = wrap(x0, img.width, tex.wrap_s);
-        let xb = wrap(x0 + 1, img.width, tex.wrap_s);
-        let ya = wrap(y0, img.height, tex.wrap_t);
-        let yb = wrap(y0 + 1, img.height, tex.wrap_t);
-        let top = texel_f(img, xa, ya, srgb).lerp(texel_f(img, xb, ya, srgb), fx);
-        let bottom = texel_f(img, xa, yb, srgb).lerp(texel_f(img, xb, yb, srgb), fx);
-        return top.lerp(bottom, fy);
+        return filter(img.width, img.height, tex.nearest, uv, |x, y| {
+            let (x, y) = at(x, y);
+            texel_f(img, x, y, srgb)
+        });
     }
     if img.rgba8.is_empty() {
         return Vec4::ONE;
     }
-    if tex.nearest {
-        let xi = wrap((x + 0.5).floor() as i64, img.width, tex.wrap_s);
-        let yi = wrap((y + 0.5).floor() as i64, img.height, tex.wrap_t);
-        let p = img.rgba8[yi * img.width as usize + xi];
-        if srgb {
-            let t = srgb_table();
-            return Vec4::new(
-                t[p[0] as usize],
-                t[p[1] as usize],
-                t[p[2] as usize],
-                p[3] as f32 / 255.0,
-            );
-        }
-        return texel(img, xi, yi);
-    }
-    let (x0, y0) = (x.floor(), y.floor());
-    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
-    let (x0, y0) = (x0 as i64, y0 as i64);
-    let xa = wrap(x0, img.width, tex.wrap_s);
-    let xb = wrap(x0 + 1, img.width, tex.wrap_s);
-    let ya = wrap(y0, img.height, tex.wrap_t);
-    let yb = wrap(y0 + 1, img.height, tex.wrap_t);
-    let top = texel(img, xa, ya).lerp(texel(img, xb, ya), fx);
-    let bottom = texel(img, xa, yb).lerp(texel(img, xb, yb), fx);
-    decode(top.lerp(bottom, fy), srgb)
+    let v = filter(img.width, img.height, tex.nearest, uv, |x, y| {
+        let (x, y) = at(x, y);
+        texel(img, x, y)
+    });
+    decode(v, srgb)
 }
 
 #[cfg(test)]

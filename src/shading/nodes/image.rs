@@ -61,27 +61,13 @@ impl ImageOp {
                 c = (c.truncate() / c.w).extend(c.w);
             }
             if byte && self.srgb {
-                c = srgb_decode(c);
+                c = texture::decode(c, true);
             }
             c
         };
         s.set_v(self.color, c.truncate());
         s.set_f(self.alpha, c.w);
     }
-}
-
-/// Blender's extension of texel index `i` into `[0, n)`.
-#[inline]
-fn wrap_index(i: i64, n: u32, mode: Wrap) -> usize {
-    let n = n as i64;
-    (match mode {
-        Wrap::Repeat => i.rem_euclid(n),
-        Wrap::ClampToEdge => i.clamp(0, n - 1),
-        Wrap::MirroredRepeat => {
-            let p = i.rem_euclid(2 * n);
-            if p < n { p } else { 2 * n - 1 - p }
-        }
-    }) as usize
 }
 
 /// Texel `(x, y)` (rows top to bottom): 8-bit ones encoded in `[0, 1]`, premultiplied in bytes
@@ -92,7 +78,7 @@ fn texel(img: &Image, x: usize, y: usize, premultiply: bool, srgb: bool) -> Vec4
     let i = y * img.width as usize + x;
     if let Some(f) = img.float.get(i) {
         let v = Vec4::from_array(*f);
-        return if srgb { srgb_decode(v) } else { v };
+        return if srgb { texture::decode(v, true) } else { v };
     }
     let [r, g, b, a] = img.rgba8[i].map(u32::from);
     if premultiply {
@@ -112,37 +98,14 @@ fn lookup(tex: &Texture, img: &Image, uv: Vec2, premultiply: bool, clip: bool, s
     if w == 0 || h == 0 || (img.rgba8.is_empty() && img.float.is_empty()) || !uv.is_finite() {
         return Vec4::ONE;
     }
-    let fetch = |x: i64, y: i64| {
+    texture::filter(w, h, tex.nearest, uv, |x, y| {
         if clip && (x < 0 || y < 0 || x >= w as i64 || y >= h as i64) {
             return Vec4::ZERO;
         }
-        let xi = wrap_index(x, w, tex.wrap_s);
-        let yi = wrap_index(y, h, tex.wrap_t);
+        let xi = texture::wrap(x, w, tex.wrap_s);
+        let yi = texture::wrap(y, h, tex.wrap_t);
         texel(img, xi, yi, premultiply, srgb)
-    };
-    let x = (uv.x as f64 * w as f64 - 0.5).clamp(-1e9, 1e9);
-    let y = (uv.y as f64 * h as f64 - 0.5).clamp(-1e9, 1e9);
-    if tex.nearest {
-        return fetch((x + 0.5).floor() as i64, (y + 0.5).floor() as i64);
-    }
-    let (x0, y0) = (x.floor(), y.floor());
-    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
-    let (x0, y0) = (x0 as i64, y0 as i64);
-    let top = fetch(x0, y0).lerp(fetch(x0 + 1, y0), fx);
-    let bottom = fetch(x0, y0 + 1).lerp(fetch(x0 + 1, y0 + 1), fx);
-    top.lerp(bottom, fy)
-}
-
-/// The sRGB decode of a filtered, encoded colour (alpha unchanged).
-fn srgb_decode(c: Vec4) -> Vec4 {
-    let d = |v: f32| {
-        if v <= 0.04045 {
-            v / 12.92
-        } else {
-            ((v + 0.055) / 1.055).powf(2.4)
-        }
-    };
-    Vec4::new(d(c.x), d(c.y), d(c.z), c.w)
+    })
 }
 
 /// Colour spaces Cycles treats as data (no colour conversion, no alpha association).
