@@ -122,6 +122,36 @@ impl RayCamera {
         }
     }
 
+    /// The camera's depth of world point `p`, as Cycles' Depth pass measures it: along the
+    /// view axis (metres in front of the camera) for perspective and orthographic cameras,
+    /// the distance from the camera for panoramic ones.
+    #[inline]
+    pub fn z_depth(&self, p: Vec3) -> f32 {
+        match self.kind {
+            Kind::Panoramic(..) => (p - self.origin).length(),
+            _ => (p - self.origin).dot(self.forward),
+        }
+    }
+
+    /// The camera distance of `p` the Mist pass uses (Cycles' `camera_distance`): along the
+    /// view axis for orthographic cameras, the distance from the camera otherwise.
+    #[inline]
+    pub fn mist_distance(&self, p: Vec3) -> f32 {
+        match self.kind {
+            Kind::Orthographic => (p - self.origin).dot(self.forward),
+            _ => (p - self.origin).length(),
+        }
+    }
+
+    /// The world direction `v` in Cycles' camera space (x right, y up, z along the view),
+    /// where the denoiser's normal feature lives.
+    #[inline]
+    pub fn to_camera_direction(&self, v: Vec3) -> Vec3 {
+        let x = self.to_world.x_axis.truncate().normalize_or_zero();
+        let y = self.to_world.y_axis.truncate().normalize_or_zero();
+        Vec3::new(v.dot(x), v.dot(y), v.dot(self.forward))
+    }
+
     /// Whether rays need a lens sample (depth of field): the caller draws one only then, so
     /// a pinhole camera consumes no random numbers for it.
     #[inline]

@@ -260,6 +260,7 @@ fn options(args: &RenderArgs, scene: &Scene) -> RenderOptions {
         threads: args.threads,
         tile_size: args.tile_size,
         region: args.region.as_ref().map(|r| [r[0], r[1], r[2], r[3]]),
+        ..Default::default()
     }
 }
 

@@ -3,12 +3,14 @@
 //! thread count. Non-finite samples are rejected (counted, never written to the film).
 
 use crate::camera::RayCamera;
+use crate::film::data::{self, DataContext};
+use crate::film::{Adaptive, PassSet, PixelAcc};
 use crate::integrator::{self, Integrator};
 use crate::render_scene::{Ctx, RayQuery, RenderScene};
 use crate::sampler::SobolSampler;
-use glam::{Vec2, Vec3};
+use glam::Vec2;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// What to render.
@@ -25,6 +27,12 @@ pub struct RenderOptions {
     pub tile_size: u32,
     /// Window `(x, y, w, h)` of the full frame to render (top-left origin); `None` = all.
     pub region: Option<[u32; 4]>,
+    /// Auxiliary passes to render besides Combined.
+    pub passes: PassSet,
+    /// Cycles' adaptive sampling; `None` renders `spp` samples in every pixel.
+    pub adaptive: Option<Adaptive>,
+    /// Stop after the sample round that crosses this many seconds (Cycles' time limit).
+    pub time_limit: Option<f64>,
 }
 
 impl Default for RenderOptions {
@@ -39,24 +47,50 @@ impl Default for RenderOptions {
             threads: 0,
             tile_size: 32,
             region: None,
+            passes: PassSet::default(),
+            adaptive: None,
+            time_limit: None,
         }
     }
 }
 
-/// A finished tile: `w × h` RGBA pixels, rows top to bottom, at `(x, y)` in the output image.
+/// A tile of the film as it stands: `w × h` RGBA pixels, rows top to bottom, at `(x, y)` in
+/// the output image, with the auxiliary passes of each pixel.
 pub struct Tile {
     pub x: u32,
     pub y: u32,
     pub w: u32,
     pub h: u32,
     pub pixels: Vec<[f32; 4]>,
+    /// `w × h` records of [`RenderOptions::passes`]' channels (`PassSet::stride` each).
+    pub aovs: Vec<f32>,
+    /// Samples per pixel reached by the round the tile comes from (adaptive sampling may
+    /// have stopped some pixels earlier).
+    pub spp: u32,
 }
 
-/// Linear RGBA image, rows top to bottom.
+/// Linear RGBA image, rows top to bottom, with its auxiliary passes.
 pub struct Image {
     pub width: u32,
     pub height: u32,
     pub pixels: Vec<[f32; 4]>,
+    pub passes: PassSet,
+    /// One record of `passes`' channels per pixel, in pixel order.
+    pub aovs: Vec<f32>,
+}
+
+impl Image {
+    /// Pass `p` as its own image: `width × height` records of `p.channels()` values.
+    pub fn pass(&self, p: crate::film::Pass) -> Option<Vec<f32>> {
+        let at = self.passes.offset(p)?;
+        let (k, stride) = (p.channels(), self.passes.stride());
+        Some(
+            self.aovs
+                .chunks_exact(stride)
+                .flat_map(|r| r[at..at + k].iter().copied())
+                .collect(),
+        )
+    }
 }
 
 /// Figures about a finished render.
@@ -69,6 +103,14 @@ pub struct RenderStats {
     pub samples_per_second: f64,
     pub rays_per_second: f64,
     pub rejected_samples: u64,
+    /// Samples per pixel reached: fewest, most, mean (they differ with adaptive sampling).
+    pub spp_min: u32,
+    pub spp_max: u32,
+    pub spp_mean: f64,
+    /// Mean per-pixel error estimate (adaptive sampling's, in units of its noise threshold).
+    pub noise: f64,
+    /// Sample rounds rendered.
+    pub rounds: u32,
 }
 
 /// Why a render did not finish.
@@ -126,6 +168,21 @@ pub fn validate(opts: &RenderOptions) -> Result<(), RenderError> {
             integrator::NAMES.join(", ")
         )));
     }
+    if let Some(t) = opts.time_limit
+        && !(t.is_finite() && t >= 0.0)
+    {
+        return Err(RenderError::Invalid(format!(
+            "time limit {t} is not a number of seconds >= 0 (0 = no limit)"
+        )));
+    }
+    if let Some(a) = &opts.adaptive
+        && !(a.threshold.is_finite() && a.threshold >= 0.0)
+    {
+        return Err(RenderError::Invalid(format!(
+            "adaptive threshold {} is not a number >= 0 (0 = automatic)",
+            a.threshold
+        )));
+    }
     if let Some([x, y, w, h]) = opts.region
         && (w == 0
             || h == 0
@@ -140,30 +197,28 @@ pub fn validate(opts: &RenderOptions) -> Result<(), RenderError> {
     Ok(())
 }
 
-/// Renders one pixel's samples with the thread's context `ctx` (its ray count and log carry
-/// on); returns the mean radiance of the accepted samples.
+/// Renders the samples `acc.next..end` of pixel `(px, py)` into its sums, with the thread's
+/// context `ctx` (its ray count and log carry on).
 #[inline]
 #[allow(clippy::too_many_arguments)]
-fn render_pixel(
+fn render_samples(
     scene: &RenderScene,
     camera: &RayCamera,
     integrator: &dyn Integrator,
     opts: &RenderOptions,
-    px: u32,
-    py: u32,
+    data: Option<&DataContext>,
+    (px, py): (u32, u32),
+    end: u32,
     ctx: &mut Ctx,
     rejected: &mut u64,
-) -> [f32; 4] {
+    acc: &mut PixelAcc,
+    aov: &mut [f32],
+) {
     let pixel_index = py as u64 * opts.width as u64 + px as u64;
-    let mut sum = Vec3::ZERO;
-    let mut accepted = 0u32;
-    // Samples where the camera sees nothing (outside a fisheye's circle): black.
-    let mut empty = 0u32;
-    // With a transparent film: the summed coverage of the accepted samples (their alpha).
-    let mut coverage = 0.0f32;
     let transparent = scene.scene.settings.film_transparent;
     let lens = camera.has_lens();
-    for s in 0..opts.spp {
+    let adaptive = opts.adaptive.is_some();
+    for s in acc.next..end {
         ctx.sampler = SobolSampler::new(opts.seed, pixel_index, s as u64);
         // Dimension 0: the pixel filter; 1: the lens, only for cameras with depth of field.
         let film = Vec2::new(px as f32, py as f32) + ctx.sampler.next_2d();
@@ -173,32 +228,29 @@ fn render_pixel(
             Vec2::ZERO
         };
         let Some(ray) = camera.ray(film, u_lens) else {
-            empty += 1;
+            acc.empty += 1;
             continue;
         };
         // The integrators trace camera rays without an end yet: `ray.tmax` (the far clip
         // distance) is not applied.
         let l = integrator.li(scene, ctx, ray.o, ray.d);
         if l.is_finite() && l.min_element() >= 0.0 {
-            sum += l;
-            accepted += 1;
+            acc.sum += l;
+            acc.accepted += 1;
             if transparent {
-                coverage += scene.camera_coverage(ctx, ray.o, ray.d);
+                acc.coverage += scene.camera_coverage(ctx, ray.o, ray.d);
+            }
+            if adaptive && s & 1 == 1 {
+                acc.half += 2.0 * l;
+            }
+            if let Some(data) = data {
+                data.add_sample(ctx, ray.o, ray.d, acc.accepted == 1, aov);
             }
         } else {
             *rejected += 1;
         }
     }
-    let n = accepted + empty;
-    let c = if n > 0 { sum / n as f32 } else { Vec3::ZERO };
-    // An opaque film, as Cycles' without "Transparent": alpha 1 everywhere. A transparent
-    // one (`render.film_transparent`): the mean coverage (`RenderScene::camera_coverage`).
-    let alpha = if transparent && n > 0 {
-        coverage / n as f32
-    } else {
-        1.0
-    };
-    [c.x, c.y, c.z, alpha]
+    acc.next = acc.next.max(end);
 }
 
 /// What every render with `opts` starts from.
@@ -236,23 +288,63 @@ pub fn record_rays(
     let mut rejected = 0;
     for y in ry..ry + rh {
         for x in rx..rx + rw {
-            render_pixel(
+            let mut acc = PixelAcc::default();
+            render_samples(
                 scene,
                 &camera,
                 integrator.as_ref(),
                 opts,
-                x,
-                y,
+                None,
+                (x, y),
+                opts.spp,
                 &mut ctx,
                 &mut rejected,
+                &mut acc,
+                &mut [],
             );
         }
     }
     Ok(ctx.log.unwrap_or_default())
 }
 
+/// One tile's pixels and their sums, owned by whichever worker renders it in a round.
+struct TileState {
+    x: u32,
+    y: u32,
+    w: u32,
+    h: u32,
+    px: Vec<PixelAcc>,
+    aov: Vec<f32>,
+    rays: u64,
+    rejected: u64,
+}
+
+impl TileState {
+    /// The tile as it stands now.
+    fn snapshot(&self, passes: &PassSet, transparent: bool, spp: u32) -> Tile {
+        let stride = passes.stride();
+        let mut aovs = vec![0.0; self.aov.len()];
+        if stride > 0 {
+            for (i, p) in self.px.iter().enumerate() {
+                let r = i * stride..(i + 1) * stride;
+                data::resolve(passes, &self.aov[r.clone()], p.accepted, &mut aovs[r]);
+            }
+        }
+        Tile {
+            x: self.x,
+            y: self.y,
+            w: self.w,
+            h: self.h,
+            pixels: self.px.iter().map(|p| p.rgba(transparent)).collect(),
+            aovs,
+            spp,
+        }
+    }
+}
+
 /// Renders the image. `on_tile(tile, tiles_done, tiles_total)` runs on a worker thread as each
-/// tile finishes. `cancel` is polled between rows.
+/// tile finishes a sample round (at most about once a second per tile when there are several
+/// rounds, and always for the last). `cancel` is polled between rows.
 pub fn render(
     scene: &RenderScene,
     opts: &RenderOptions,
@@ -265,77 +357,151 @@ pub fn render(
         region: [rx, ry, rw, rh],
     } = prepare(scene, opts)?;
     let ts = opts.tile_size.max(1);
+    let stride = opts.passes.stride();
     let mut tiles = Vec::new();
     for ty in (0..rh).step_by(ts as usize) {
         for tx in (0..rw).step_by(ts as usize) {
-            tiles.push((tx, ty, ts.min(rw - tx), ts.min(rh - ty)));
+            let (tw, th) = (ts.min(rw - tx), ts.min(rh - ty));
+            let n = (tw * th) as usize;
+            tiles.push(TileState {
+                x: tx,
+                y: ty,
+                w: tw,
+                h: th,
+                px: vec![PixelAcc::default(); n],
+                aov: vec![0.0; n * stride],
+                rays: 0,
+                rejected: 0,
+            });
         }
     }
-    let total = tiles.len();
+    let data_ctx = (!opts.passes.is_empty()).then_some(DataContext {
+        scene,
+        camera: &camera,
+        passes: &opts.passes,
+        mist: scene.scene.settings.mist,
+    });
+    let transparent = scene.scene.settings.film_transparent;
+    let time_limit = opts.time_limit.filter(|t| *t > 0.0);
+    let ends = crate::film::round_ends(opts.spp, opts.adaptive.as_ref(), time_limit.is_some());
+    let threshold = opts.adaptive.map(|a| a.resolved(opts.spp).0);
+    let total = tiles.len() * ends.len();
     let done = AtomicUsize::new(0);
-    let rays = AtomicU64::new(0);
-    let rejected = AtomicU64::new(0);
     let start = Instant::now();
-
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads)
         .build()
         .map_err(|e| RenderError::Invalid(format!("cannot start worker threads: {e}")))?;
-    let results: Result<Vec<Tile>, RenderError> = pool.install(|| {
-        tiles
-            .par_iter()
-            .map(|&(tx, ty, tw, th)| {
-                let mut pixels = Vec::with_capacity((tw * th) as usize);
+
+    let mut last_stream: Option<Instant> = None;
+    let mut streamed_last = false;
+    let mut rounds = 0;
+    for (ri, &end) in ends.iter().enumerate() {
+        let last = ri + 1 == ends.len();
+        let stream = last || last_stream.is_none_or(|t| t.elapsed().as_secs_f64() >= 1.0);
+        let result: Result<(), RenderError> = pool.install(|| {
+            tiles.par_iter_mut().try_for_each(|t| {
                 let mut ctx = Ctx::new(SobolSampler::new(0, 0, 0));
                 let mut rej = 0u64;
-                for y in 0..th {
+                let mut worked = false;
+                for y in 0..t.h {
                     if cancel.load(Ordering::Relaxed) {
                         return Err(RenderError::Cancelled);
                     }
-                    for x in 0..tw {
-                        pixels.push(render_pixel(
+                    for x in 0..t.w {
+                        let i = (y * t.w + x) as usize;
+                        let acc = &mut t.px[i];
+                        if acc.converged || acc.next >= end {
+                            continue;
+                        }
+                        worked = true;
+                        render_samples(
                             scene,
                             &camera,
                             integrator.as_ref(),
                             opts,
-                            rx + tx + x,
-                            ry + ty + y,
+                            data_ctx.as_ref(),
+                            (rx + t.x + x, ry + t.y + y),
+                            end,
                             &mut ctx,
                             &mut rej,
-                        ));
+                            acc,
+                            &mut t.aov[i * stride..(i + 1) * stride],
+                        );
                     }
                 }
-                rays.fetch_add(ctx.rays, Ordering::Relaxed);
-                rejected.fetch_add(rej, Ordering::Relaxed);
-                let tile = Tile {
-                    x: tx,
-                    y: ty,
-                    w: tw,
-                    h: th,
-                    pixels,
-                };
+                t.rays += ctx.rays;
+                t.rejected += rej;
                 let n = done.fetch_add(1, Ordering::Relaxed) + 1;
-                on_tile(&tile, n, total);
-                Ok(tile)
+                if stream && (worked || last) {
+                    on_tile(&t.snapshot(&opts.passes, transparent, end), n, total);
+                }
+                Ok(())
             })
-            .collect()
-    });
-    let tiles = results?;
+        });
+        result?;
+        rounds += 1;
+        if stream {
+            last_stream = Some(Instant::now());
+        }
+        streamed_last = stream;
+        if last {
+            break;
+        }
+        let mut all_converged = false;
+        if let Some(threshold) = threshold {
+            all_converged = check_convergence(&mut tiles, rw, rh, threshold);
+        }
+        let out_of_time = time_limit.is_some_and(|t| start.elapsed().as_secs_f64() >= t);
+        if all_converged || out_of_time {
+            break;
+        }
+    }
+    if !streamed_last {
+        // The render stopped early after a round that was not streamed: send the final film.
+        let n = tiles.len();
+        for (i, t) in tiles.iter().enumerate() {
+            let spp = t.px.iter().map(|p| p.next).max().unwrap_or(0);
+            on_tile(
+                &t.snapshot(&opts.passes, transparent, spp),
+                total - n + i + 1,
+                total,
+            );
+        }
+    }
+
     let mut image = Image {
         width: rw,
         height: rh,
         pixels: vec![[0.0; 4]; rw as usize * rh as usize],
+        passes: opts.passes.clone(),
+        aovs: vec![0.0; rw as usize * rh as usize * stride],
     };
+    let (mut rays, mut rejected, mut samples) = (0u64, 0u64, 0u64);
+    let (mut spp_min, mut spp_max, mut noise) = (u32::MAX, 0u32, 0.0f64);
     for t in &tiles {
+        let snap = t.snapshot(&opts.passes, transparent, 0);
         for y in 0..t.h {
-            let src = &t.pixels[(y * t.w) as usize..((y + 1) * t.w) as usize];
+            let src = &snap.pixels[(y * t.w) as usize..((y + 1) * t.w) as usize];
             let row = (t.y + y) as usize * rw as usize + t.x as usize;
             image.pixels[row..row + t.w as usize].copy_from_slice(src);
+            let a = (y * t.w) as usize * stride..((y + 1) * t.w) as usize * stride;
+            image.aovs[row * stride..(row + t.w as usize) * stride].copy_from_slice(&snap.aovs[a]);
         }
+        for p in &t.px {
+            samples += p.next as u64;
+            spp_min = spp_min.min(p.next);
+            spp_max = spp_max.max(p.next);
+            let e = p.error() as f64;
+            if e.is_finite() {
+                noise += e;
+            }
+        }
+        rays += t.rays;
+        rejected += t.rejected;
     }
+    let pixels = (rw as u64 * rh as u64).max(1);
     let seconds = start.elapsed().as_secs_f64();
-    let samples = rw as u64 * rh as u64 * opts.spp as u64;
-    let rays = rays.into_inner();
     Ok((
         image,
         RenderStats {
@@ -344,7 +510,41 @@ pub fn render(
             rays,
             samples_per_second: samples as f64 / seconds.max(1e-9),
             rays_per_second: rays as f64 / seconds.max(1e-9),
-            rejected_samples: rejected.into_inner(),
+            rejected_samples: rejected,
+            spp_min: spp_min.min(spp_max),
+            spp_max,
+            spp_mean: samples as f64 / pixels as f64,
+            // In units of the noise threshold the user sets (Cycles' internal one is 5x).
+            noise: noise / pixels as f64 / 5.0,
+            rounds,
         },
     ))
+}
+
+/// Adaptive sampling's check after a round: marks the pixels whose error is below
+/// `threshold` converged, then un-marks the neighbours of unconverged pixels. True when
+/// every pixel has converged.
+fn check_convergence(tiles: &mut [TileState], rw: u32, rh: u32, threshold: f32) -> bool {
+    let (w, h) = (rw as usize, rh as usize);
+    let mut mask = vec![false; w * h];
+    for t in tiles.iter() {
+        for (i, p) in t.px.iter().enumerate() {
+            let (x, y) = (
+                t.x as usize + i % t.w as usize,
+                t.y as usize + i / t.w as usize,
+            );
+            mask[y * w + x] = p.converged || p.error() < threshold;
+        }
+    }
+    crate::film::dilate_unconverged(&mut mask, w, h);
+    let mut all = true;
+    for t in tiles.iter_mut() {
+        let tw = t.w as usize;
+        for (i, p) in t.px.iter_mut().enumerate() {
+            let (x, y) = (t.x as usize + i % tw, t.y as usize + i / tw);
+            p.converged = mask[y * w + x];
+            all &= p.converged;
+        }
+    }
+    all
 }

@@ -830,6 +830,22 @@ impl RenderScene {
         Some((b, le, rec))
     }
 
+    /// The world's radiance along `d` (from `from`) as the camera sees it with an opaque film
+    /// (the Environment pass); zero when the world is hidden from the camera.
+    pub fn world_radiance(&self, d: Vec3, from: Vec3) -> Vec3 {
+        let Some(b) = self.background else {
+            return Vec3::ZERO;
+        };
+        if !self.scene.world.visible_camera {
+            return Vec3::ZERO;
+        }
+        let flags = crate::shading::globals::ray::CAMERA;
+        match &self.emitters[b as usize] {
+            EmitterInstance::Environment(env) => env.radiance(&self.scene, d, 1, flags),
+            e => e.eval(&self.scene, &EmitterQueryRecord::towards(from, d)),
+        }
+    }
+
     /// The film's coverage along a camera ray (its alpha): 1 without `film_transparent`;
     /// with it, 1 where the ray meets an opaque surface, 0 where it escapes to the world, and
     /// one minus the mean transmittance of the transparent surfaces it passes on the way out

@@ -274,6 +274,7 @@ fn render_scene(scene: Scene, w: u32, h: u32, spp: u32, threads: usize) -> Vec<[
         threads,
         tile_size: 16,
         region: None,
+        ..Default::default()
     };
     let (img, stats) = render::render(&rs, &opts, &AtomicBool::new(false), &|_, _, _| {}).unwrap();
     assert_eq!(stats.rejected_samples, 0, "non-finite samples");

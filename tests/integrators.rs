@@ -37,6 +37,7 @@ fn opts(integrator: &str, size: u32, spp: u32, max_depth: u32, seed: u64) -> Ren
         threads: 0,
         tile_size: 16,
         region: None,
+        ..Default::default()
     }
 }
 

@@ -107,6 +107,7 @@ fn render_mean(scene: Scene, integrator: &str, spp: u32, max_depth: u32) -> (f64
         threads: 0,
         tile_size: 16,
         region: None,
+        ..Default::default()
     };
     let (img, stats) = render::render(&rs, &opts, &AtomicBool::new(false), &|_, _, _| {}).unwrap();
     assert_eq!(stats.rejected_samples, 0, "non-finite samples");
@@ -743,6 +744,7 @@ fn light_tree_is_unbiased_and_less_noisy() {
             threads: 0,
             tile_size: 16,
             region: None,
+            ..Default::default()
         };
         let (img, st) = render::render(rs, &opts, &AtomicBool::new(false), &|_, _, _| {}).unwrap();
         assert_eq!(st.rejected_samples, 0);

@@ -721,6 +721,7 @@ fn render_all(name: &str, scene: &Scene) -> f32 {
             threads: 1,
             tile_size: 4,
             region: None,
+            ..Default::default()
         };
         let (img, stats) = render::render(&rs, &opts, &AtomicBool::new(false), &|_, _, _| {})
             .unwrap_or_else(|e| panic!("{name}/{integrator}: {e}"));

@@ -24,6 +24,7 @@ fn opts(integrator: &str, size: u32, spp: u32, max_depth: u32) -> RenderOptions 
         threads: 0,
         tile_size: 16,
         region: None,
+        ..Default::default()
     }
 }
 

@@ -337,6 +337,8 @@ pub struct Material {
     /// The material's node graph (`TESELA_material_graph`); without one, the renderer shades
     /// with the glTF metallic-roughness preset graph built from the factors above.
     pub graph: Option<Arc<crate::shading::Graph>>,
+    /// Blender's material pass index (the Material Index pass).
+    pub pass_index: u32,
 }
 
 impl Default for Material {
@@ -370,6 +372,7 @@ impl Default for Material {
             anisotropy: None,
             volume: None,
             graph: None,
+            pass_index: 0,
         }
     }
 }
@@ -687,6 +690,49 @@ pub struct RenderSettings {
     /// Blender's `render.film_transparent`: camera rays that see only the world give alpha 0
     /// (and no colour).
     pub film_transparent: bool,
+    /// The world's mist settings (the Mist pass).
+    pub mist: Mist,
+}
+
+/// Blender's `world.mist_settings`: mist grows from `start` over `depth` metres of camera
+/// distance with exponent `falloff` (quadratic 2, linear 1, inverse quadratic 0.5).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mist {
+    pub start: f32,
+    pub depth: f32,
+    pub falloff: f32,
+}
+
+impl Default for Mist {
+    /// Blender's defaults: start 5 m, depth 25 m, quadratic.
+    fn default() -> Self {
+        Mist {
+            start: 5.0,
+            depth: 25.0,
+            falloff: 2.0,
+        }
+    }
+}
+
+impl Mist {
+    /// The mist amount in `[0, 1]` at camera distance `dist` (Cycles' formula).
+    pub fn amount(&self, dist: f32) -> f32 {
+        let inv_depth = if self.depth > 0.0 {
+            1.0 / self.depth
+        } else {
+            0.0
+        };
+        let m = ((dist - self.start) * inv_depth).clamp(0.0, 1.0);
+        if self.falloff == 1.0 {
+            m
+        } else if self.falloff == 2.0 {
+            m * m
+        } else if self.falloff == 0.5 {
+            m.sqrt()
+        } else {
+            m.powf(self.falloff)
+        }
+    }
 }
 
 /// A complete scene.

@@ -303,6 +303,10 @@ impl<'a> Loader<'a> {
             .and_then(|e| member(e, "two_sided"))
             .and_then(Value::as_bool)
             .unwrap_or(double_sided);
+        let pass_index = extension(raw, "TESELA_material_graph")
+            .and_then(|g| member(g, "pass_index"))
+            .and_then(Value::as_u64)
+            .map_or(0, |v| v.min(u32::MAX as u64) as u32);
         let graph = match extension(raw, "TESELA_material_graph") {
             Some(g) => Some(std::sync::Arc::new(self.material_graph(g, gi, &name)?)),
             None => None,
@@ -335,6 +339,7 @@ impl<'a> Loader<'a> {
             anisotropy,
             volume,
             graph,
+            pass_index,
         })
     }
 

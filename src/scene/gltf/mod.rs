@@ -449,6 +449,21 @@ impl<'a> Loader<'a> {
             s.film_transparent = member(r, "film_transparent")
                 .and_then(Value::as_bool)
                 .unwrap_or(false);
+            if let Some(m) = member(r, "mist") {
+                let f = |k: &str, d: f32| {
+                    member(m, k)
+                        .and_then(Value::as_f64)
+                        .map(|v| v as f32)
+                        .filter(|v| v.is_finite())
+                        .unwrap_or(d)
+                };
+                let d = crate::scene::Mist::default();
+                s.mist = crate::scene::Mist {
+                    start: f("start", d.start),
+                    depth: f("depth", d.depth).max(0.0),
+                    falloff: f("falloff", d.falloff).max(0.0),
+                };
+            }
             self.scene.settings = s;
         }
         Ok(())

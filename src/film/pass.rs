@@ -1,0 +1,214 @@
+//! The render passes besides Combined, with Cycles' names and meanings.
+
+/// One auxiliary pass of the film. Names and channel layouts are Blender's (what Cycles
+/// registers in a view layer), so the add-on can fill the render result directly.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Pass {
+    /// Camera-space depth of the first surface (distance along the view axis; ray length for
+    /// panoramic cameras), from the pixel's first sample; 1e10 where the ray escapes.
+    Depth,
+    /// `1 - (1 - mist) · alpha` averaged, with Blender's mist start, depth and falloff.
+    Mist,
+    /// Average closure normal at the first surface, Blender world space (Z up).
+    Normal,
+    /// First surface position, Blender world space, from the pixel's first sample.
+    Position,
+    /// First UV map at the first surface: `(u, v, 1)`, Blender's convention (v up).
+    Uv,
+    /// The object's pass index (Object > Relations), from the pixel's first sample.
+    ObjectIndex,
+    /// The material's pass index (Material > Settings), from the pixel's first sample.
+    MaterialIndex,
+    /// Emission seen directly by the camera (surfaces and lights), through transparency.
+    Emission,
+    /// The world seen directly by the camera, even with a transparent film.
+    Environment,
+    /// The denoiser's normal feature: albedo-weighted closure normal, Blender world space.
+    DenoisingNormal,
+    /// The denoiser's albedo feature: the summed closure albedo at the first surface.
+    DenoisingAlbedo,
+}
+
+impl Pass {
+    pub const ALL: [Pass; 11] = [
+        Pass::Depth,
+        Pass::Mist,
+        Pass::Normal,
+        Pass::Position,
+        Pass::Uv,
+        Pass::ObjectIndex,
+        Pass::MaterialIndex,
+        Pass::Emission,
+        Pass::Environment,
+        Pass::DenoisingNormal,
+        Pass::DenoisingAlbedo,
+    ];
+
+    /// The command line's name (`--passes depth,normal,...`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Pass::Depth => "depth",
+            Pass::Mist => "mist",
+            Pass::Normal => "normal",
+            Pass::Position => "position",
+            Pass::Uv => "uv",
+            Pass::ObjectIndex => "object_index",
+            Pass::MaterialIndex => "material_index",
+            Pass::Emission => "emission",
+            Pass::Environment => "environment",
+            Pass::DenoisingNormal => "denoising_normal",
+            Pass::DenoisingAlbedo => "denoising_albedo",
+        }
+    }
+
+    /// Blender's render pass name.
+    pub fn blender_name(self) -> &'static str {
+        match self {
+            Pass::Depth => "Depth",
+            Pass::Mist => "Mist",
+            Pass::Normal => "Normal",
+            Pass::Position => "Position",
+            Pass::Uv => "UV",
+            Pass::ObjectIndex => "IndexOB",
+            Pass::MaterialIndex => "IndexMA",
+            Pass::Emission => "Emit",
+            Pass::Environment => "Env",
+            Pass::DenoisingNormal => "Denoising Normal",
+            Pass::DenoisingAlbedo => "Denoising Albedo",
+        }
+    }
+
+    /// Blender's channel ids, one letter per channel.
+    pub fn channel_ids(self) -> &'static str {
+        match self {
+            Pass::Depth | Pass::Mist => "Z",
+            Pass::ObjectIndex | Pass::MaterialIndex => "X",
+            Pass::Normal | Pass::Position | Pass::DenoisingNormal => "XYZ",
+            Pass::Uv => "UVA",
+            _ => "RGB",
+        }
+    }
+
+    pub fn channels(self) -> usize {
+        self.channel_ids().len()
+    }
+
+    pub fn from_name(name: &str) -> Option<Pass> {
+        Pass::ALL.into_iter().find(|p| p.name() == name)
+    }
+
+    /// Written by the pixel's first sample only, as Cycles writes it (an average of depths or
+    /// indices across an edge means nothing).
+    pub fn first_sample_only(self) -> bool {
+        matches!(
+            self,
+            Pass::Depth | Pass::Position | Pass::ObjectIndex | Pass::MaterialIndex
+        )
+    }
+}
+
+/// The enabled passes in a fixed order, with each one's offset in a pixel's channel record.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PassSet {
+    passes: Vec<Pass>,
+    offsets: Vec<usize>,
+    stride: usize,
+}
+
+impl PassSet {
+    /// The passes named in `names` (command-line names, or Blender's), in [`Pass::ALL`]'s
+    /// order, each once. An unknown name is an error listing the known ones.
+    pub fn parse<'a>(names: impl IntoIterator<Item = &'a str>) -> Result<PassSet, String> {
+        let mut want = Vec::new();
+        for n in names {
+            let n = n.trim();
+            if n.is_empty() {
+                continue;
+            }
+            let p = Pass::from_name(n)
+                .or_else(|| Pass::ALL.into_iter().find(|p| p.blender_name() == n))
+                .ok_or_else(|| {
+                    format!(
+                        "unknown pass `{n}` (known passes: {})",
+                        Pass::ALL.map(Pass::name).join(", ")
+                    )
+                })?;
+            want.push(p);
+        }
+        Ok(PassSet::new(
+            Pass::ALL.into_iter().filter(|p| want.contains(p)),
+        ))
+    }
+
+    pub fn new(passes: impl IntoIterator<Item = Pass>) -> PassSet {
+        let mut set = PassSet::default();
+        for p in passes {
+            if set.passes.contains(&p) {
+                continue;
+            }
+            set.offsets.push(set.stride);
+            set.stride += p.channels();
+            set.passes.push(p);
+        }
+        set
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.passes.is_empty()
+    }
+
+    pub fn contains(&self, p: Pass) -> bool {
+        self.passes.contains(&p)
+    }
+
+    /// The offset of pass `p` in a pixel's record, if enabled.
+    #[inline]
+    pub fn offset(&self, p: Pass) -> Option<usize> {
+        self.passes
+            .iter()
+            .position(|&q| q == p)
+            .map(|i| self.offsets[i])
+    }
+
+    /// Channels per pixel, all passes together.
+    pub fn stride(&self) -> usize {
+        self.stride
+    }
+
+    /// `(pass, offset)` in order.
+    pub fn iter(&self) -> impl Iterator<Item = (Pass, usize)> + '_ {
+        self.passes
+            .iter()
+            .copied()
+            .zip(self.offsets.iter().copied())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_parse_in_canonical_order_with_offsets() {
+        let s = PassSet::parse(["normal", "Depth", "uv", "depth"]).unwrap();
+        let got: Vec<_> = s.iter().collect();
+        assert_eq!(
+            got,
+            vec![(Pass::Depth, 0), (Pass::Normal, 1), (Pass::Uv, 4)]
+        );
+        assert_eq!(s.stride(), 7);
+        let e = PassSet::parse(["depth", "shiny"]).unwrap_err();
+        assert!(e.contains("`shiny`") && e.contains("object_index"), "{e}");
+    }
+
+    #[test]
+    fn every_pass_has_distinct_names() {
+        for (i, a) in Pass::ALL.iter().enumerate() {
+            assert_eq!(Pass::from_name(a.name()), Some(*a));
+            for b in &Pass::ALL[i + 1..] {
+                assert_ne!(a.name(), b.name());
+                assert_ne!(a.blender_name(), b.blender_name());
+            }
+        }
+    }
+}
