@@ -36,7 +36,7 @@ W, H = 3840, 2160
 
 def producer_cmd(args, gltf):
     if args.renderer:
-        return [args.renderer, "render", gltf, "--pipe", "--width", str(W), "--height", str(H),
+        return [args.renderer, "render", gltf, "--pipe", "--pipe-version", "2", "--width", str(W), "--height", str(H),
                 "--spp", "1", "--integrator", "albedo"]
     return [sys.executable, str(REPO / "tests/blender/fake_renderer.py"), "render", gltf, "--pipe",
             "--width", str(W), "--height", str(H), "--spp", "1"]

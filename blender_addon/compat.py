@@ -227,6 +227,29 @@ def pass_rect_set(render_pass, flat_rgba):
         render_pass.rect.foreach_set(flat_rgba.reshape(-1, render_pass.channels))
 
 
+# Blender 4.2 renamed the short render pass names Cycles registers (IndexOB -> Object Index).
+_PASS_NAMES_4_2 = {"IndexOB": "Object Index", "IndexMA": "Material Index", "Emit": "Emission",
+                   "Env": "Environment"}
+
+
+def pass_name(name):
+    """This Blender's name of the render pass the renderer calls `name` (Blender 3.x names)."""
+    if bpy.app.version >= (4, 2, 0):
+        return _PASS_NAMES_4_2.get(name, name)
+    return name
+
+
+def find_pass(result, name):
+    """The pass called `name` of the result's first layer, or None."""
+    layer = result.layers[0]
+    if hasattr(layer.passes, "find_by_name"):
+        return layer.passes.find_by_name(name, "")
+    for p in layer.passes:
+        if p.name == name:
+            return p
+    return None
+
+
 def combined_pass(result):
     layer = result.layers[0]
     p = layer.passes.find_by_name("Combined", "") if hasattr(layer.passes, "find_by_name") else None

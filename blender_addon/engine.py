@@ -14,7 +14,7 @@ import time
 import bpy
 import numpy as np
 
-from . import compat, export, preferences, protocol, report
+from . import compat, export, passes, preferences, protocol, report
 
 POLL_SECONDS = 0.03        # how often render() looks at the queue and test_break()
 PUSH_SECONDS = 0.25        # how often the render result is refreshed
@@ -183,8 +183,8 @@ class RenderSession:
         return code
 
 
-def renderer_args(binary, gltf, settings, width, height, region):
-    args = [binary, "render", gltf, "--pipe",
+def renderer_args(binary, gltf, settings, width, height, region, pass_names=()):
+    args = [binary, "render", gltf, "--pipe", "--pipe-version", str(protocol.PROTOCOL_VERSION),
             "--integrator", settings.integrator,
             "--spp", str(settings.samples),
             "--max-depth", str(settings.max_depth),
@@ -194,7 +194,18 @@ def renderer_args(binary, gltf, settings, width, height, region):
         args += ["--threads", str(settings.threads)]
     if region is not None:
         args += ["--region"] + [str(v) for v in region]
+    if pass_names:
+        args += ["--passes", ",".join(pass_names)]
+    if getattr(settings, "use_adaptive_sampling", False):
+        args += ["--adaptive-threshold", repr(float(settings.adaptive_threshold)),
+                 "--adaptive-min-samples", str(settings.adaptive_min_samples)]
+    if getattr(settings, "time_limit", 0.0) > 0.0:
+        args += ["--time-limit", repr(float(settings.time_limit))]
     return args
+
+
+OLD_RENDERER = ("the renderer %s is older than this add-on: it does not speak pipe protocol "
+                "version %d (install the renderer that came with the add-on)")
 
 
 class TeselaRenderEngine(bpy.types.RenderEngine):
@@ -224,6 +235,14 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
                 self.error_set(message)
             except (TypeError, RuntimeError):
                 pass
+
+    # -- passes -----------------------------------------------------------------
+
+    def update_render_passes(self, scene=None, renderlayer=None):
+        """Declares the passes Blender's compositor and render result will have."""
+        self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
+        for _, bname, ids, kind in passes.enabled(renderlayer, scene.tesela):
+            self.register_pass(scene, renderlayer, compat.pass_name(bname), len(ids), ids, kind)
 
     # -- render -----------------------------------------------------------------
 
@@ -306,8 +325,24 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
             return
         # Full-frame mirror of the result, rows bottom to top (Blender's order).
         mirror = np.zeros((rh, rw, 4), dtype=np.float32)
+        # The other passes: {Blender name: (render pass, mirror)}.
+        pass_targets = {}
+        pass_names = []
+        for name, bname, ids, _ in passes.enabled(depsgraph.view_layer, settings):
+            rp = compat.find_pass(result, compat.pass_name(bname))
+            if rp is None or rp.channels != len(ids):
+                self.report({"WARNING"}, "Tesela: the render result has no %s pass"
+                            % compat.pass_name(bname))
+                continue
+            pass_names.append(name)
+            pass_targets[bname] = (rp, np.zeros((rh, rw, len(ids)), dtype=np.float32))
+        left_out = passes.unsupported(depsgraph.view_layer)
+        if left_out:
+            message = "Tesela does not render these passes yet (left empty): " + ", ".join(left_out)
+            print("Tesela: " + message)
+            self.report({"WARNING"}, "Tesela: " + message)
 
-        args = renderer_args(binary, gltf, settings, width, height, region)
+        args = renderer_args(binary, gltf, settings, width, height, region, pass_names)
         try:
             session.start(args)
         except OSError as exc:
@@ -334,6 +369,8 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
         def push(final=False):
             t = time.monotonic()
             compat.pass_rect_set(target, mirror.reshape(-1))
+            for rp, m in pass_targets.values():
+                compat.pass_rect_set(rp, m.reshape(-1))
             if not final:  # end_result() publishes the final image itself
                 self.update_result(result)
             push_cost[0] = time.monotonic() - t
@@ -380,6 +417,10 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
                         finished = True
                         break
                     mirror[rh - y - h:rh - y, x:x + w] = msg.pixels[::-1]
+                    for bname, data in msg.passes.items():
+                        t = pass_targets.get(bname)
+                        if t is not None:
+                            t[1][rh - y - h:rh - y, x:x + w] = data[::-1]
                     dirty = True
                 elif isinstance(msg, protocol.Progress):
                     tiles_done, tiles_total, spp_now = msg.tiles_done, msg.tiles_total, msg.spp
@@ -461,7 +502,9 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
             return
         if done is None:
             tail = session.stderr.text() if session.stderr is not None else ""
-            if hello is None:
+            if hello is None and code == 2 and "--pipe-version" in tail:
+                msg = OLD_RENDERER % (binary, protocol.PROTOCOL_VERSION)
+            elif hello is None:
                 msg = "the renderer exited without starting the render (%s)" % _describe_exit(code)
             else:
                 msg = "the renderer stopped mid-render (%s)" % _describe_exit(code)

@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: MIT
-"""scene.tesela: render settings, as Cycles keeps scene.cycles."""
+"""scene.tesela: render settings, as Cycles keeps scene.cycles (the same property names where
+the meaning is the same, so settings and scripts carry over)."""
 
 import bpy
-from bpy.props import EnumProperty, IntProperty, PointerProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
 INTEGRATORS = [
     ("path_mis", "Path (MIS)", "Unidirectional path tracing with multiple importance sampling"),
@@ -18,13 +19,39 @@ INTEGRATORS = [
 class TeselaSceneSettings(bpy.types.PropertyGroup):
     integrator: EnumProperty(name="Integrator", items=INTEGRATORS, default="path_mis",
                              description="Light transport algorithm")
-    samples: IntProperty(name="Samples", default=64, min=1, max=1 << 20, soft_max=4096,
-                         description="Samples per pixel")
+    samples: IntProperty(name="Samples", default=1024, min=1, max=1 << 20, soft_max=4096,
+                         description="Samples per pixel (the most, with a noise threshold)")
     max_depth: IntProperty(name="Max Depth", default=14, min=1, max=1024,
                            description="Maximum number of path vertices (Cycles' max bounces + 2)")
     seed: IntProperty(name="Seed", default=0, min=0, description="Random seed")
     threads: IntProperty(name="Threads", default=0, min=0, max=1024,
                          description="Render threads (0: all cores)")
+    use_adaptive_sampling: BoolProperty(
+        name="Noise Threshold", default=True,
+        description="Automatically stop sampling pixels whose noise falls below the threshold "
+                    "(Cycles' adaptive sampling)")
+    adaptive_threshold: FloatProperty(
+        name="Noise Threshold", default=0.01, min=0.0, max=1.0, soft_min=0.001, precision=4,
+        description="Noise level at which a pixel stops (0: automatic from the sample count)")
+    adaptive_min_samples: IntProperty(
+        name="Min Samples", default=0, min=0, max=4096,
+        description="Samples every pixel takes before it may stop (0: automatic)")
+    time_limit: FloatProperty(
+        name="Time Limit", default=0.0, min=0.0, subtype="TIME_ABSOLUTE",
+        description="Stop rendering after this many seconds (0: no limit)")
+    use_denoising: BoolProperty(
+        name="Denoise", default=True,
+        description="Denoise the final image with Intel Open Image Denoise (when the renderer "
+                    "finds the library)")
+    denoising_prefilter: EnumProperty(
+        name="Prefilter", default="ACCURATE",
+        items=[("NONE", "None", "No prefiltering of the albedo and normal passes"),
+               ("FAST", "Fast", "Use the albedo and normal passes as rendered"),
+               ("ACCURATE", "Accurate", "Denoise the albedo and normal passes first")],
+        description="How the denoiser's albedo and normal passes are treated")
+    denoising_store_passes: BoolProperty(
+        name="Denoising Data", default=False,
+        description="Store the Denoising Normal and Denoising Albedo passes in the render result")
 
 
 def register():

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""Reader for the Tesela pipe protocol (docs/protocol.md, version 1).
+"""Reader for the Tesela pipe protocol (docs/protocol.md, version 2).
 
 Pure Python (struct) plus numpy for tile payloads; no bpy, so the reader is
 usable and testable outside Blender.
@@ -13,7 +13,7 @@ try:  # numpy ships with Blender; the fallback keeps the module importable.
 except ImportError:  # pragma: no cover
     np = None
 
-PROTOCOL_VERSION = 1
+PROTOCOL_VERSION = 2
 MAGIC = b"TSLA"
 MAX_PAYLOAD = 1 << 30  # 1 GiB
 
@@ -31,12 +31,17 @@ class ProtocolError(Exception):
     """The byte stream does not follow the protocol."""
 
 
-class Hello:
-    __slots__ = ("version", "width", "height", "spp", "tile_count")
+COMBINED = ("Combined", "RGBA")
 
-    def __init__(self, version, width, height, spp, tile_count):
+
+class Hello:
+    __slots__ = ("version", "width", "height", "spp", "tile_count", "passes")
+
+    def __init__(self, version, width, height, spp, tile_count, passes=(COMBINED,)):
         self.version, self.width, self.height = version, width, height
         self.spp, self.tile_count = spp, tile_count
+        # [(Blender pass name, channel ids)], Combined first: the layout of every tile.
+        self.passes = list(passes)
 
     def __repr__(self):
         return "Hello(v%d, %dx%d, spp=%d, tiles=%d)" % (
@@ -44,11 +49,13 @@ class Hello:
 
 
 class Tile:
-    __slots__ = ("x", "y", "w", "h", "pixels")
+    __slots__ = ("x", "y", "w", "h", "pixels", "passes")
 
-    def __init__(self, x, y, w, h, pixels):
-        # pixels: float32 array shaped (h, w, 4), row 0 = top of the tile.
+    def __init__(self, x, y, w, h, pixels, passes=None):
+        # pixels: float32 array shaped (h, w, 4), row 0 = top of the tile (Combined).
+        # passes: {Blender pass name: float32 array (h, w, channels)} of the other passes.
         self.x, self.y, self.w, self.h, self.pixels = x, y, w, h, pixels
+        self.passes = passes or {}
 
     def __repr__(self):
         return "Tile(%d, %d, %dx%d)" % (self.x, self.y, self.w, self.h)
@@ -134,26 +141,63 @@ def _utf8(payload):
     return bytes(payload).decode("utf-8", errors="replace")
 
 
-def decode(kind, payload):
-    """Turn one frame into a message object; None for unknown kinds."""
+def _hello_passes(payload, at):
+    """The version-2 pass list of a HELLO payload from offset `at`."""
+    def u32(at):
+        if len(payload) < at + 4:
+            raise ProtocolError("HELLO pass list truncated")
+        return struct.unpack_from("<I", payload, at)[0], at + 4
+
+    count, at = u32(at)
+    if count > 1024:
+        raise ProtocolError("HELLO announces %d passes" % count)
+    passes = []
+    for _ in range(count):
+        texts = []
+        for _ in range(2):
+            n, at = u32(at)
+            if len(payload) < at + n:
+                raise ProtocolError("HELLO pass list truncated")
+            texts.append(_utf8(payload[at:at + n]))
+            at += n
+        passes.append(tuple(texts))
+    if not passes or passes[0] != COMBINED:
+        raise ProtocolError("HELLO pass list does not start with Combined RGBA")
+    return passes
+
+
+def decode(kind, payload, hello=None):
+    """Turn one frame into a message object; None for unknown kinds. Tiles are laid out by
+    the passes of `hello` (Combined only without one)."""
     if kind == HELLO:
         if len(payload) < _HELLO.size:
             raise ProtocolError("HELLO payload too short (%d bytes)" % len(payload))
         magic, version, w, h, spp, tiles = _HELLO.unpack_from(payload, 0)
         if magic != MAGIC:
             raise ProtocolError("not a Tesela renderer (bad magic)")
-        return Hello(version, w, h, spp, tiles)
+        # Only this version's layout is known; another version is reported by the reader.
+        passes = _hello_passes(payload, _HELLO.size) if version == 2 else [COMBINED]
+        return Hello(version, w, h, spp, tiles, passes)
     if kind == TILE:
         if len(payload) < _TILE_HEAD.size:
             raise ProtocolError("TILE payload too short (%d bytes)" % len(payload))
         x, y, w, h = _TILE_HEAD.unpack_from(payload, 0)
-        expected = _TILE_HEAD.size + w * h * 16
+        layout = hello.passes if hello is not None else [COMBINED]
+        channels = sum(len(c) for _, c in layout)
+        expected = _TILE_HEAD.size + w * h * 4 * channels
         if len(payload) != expected:
             raise ProtocolError("TILE %dx%d at (%d, %d): payload is %d bytes, expected %d"
                                 % (w, h, x, y, len(payload), expected))
-        pixels = np.frombuffer(payload, dtype="<f4", count=w * h * 4,
-                               offset=_TILE_HEAD.size).reshape(h, w, 4)
-        return Tile(x, y, w, h, pixels)
+        data = np.frombuffer(payload, dtype="<f4", count=w * h * channels,
+                             offset=_TILE_HEAD.size)
+        at = w * h * 4
+        pixels = data[:at].reshape(h, w, 4)
+        passes = {}
+        for name, ids in layout[1:]:
+            k = len(ids)
+            passes[name] = data[at:at + w * h * k].reshape(h, w, k)
+            at += w * h * k
+        return Tile(x, y, w, h, pixels, passes)
     if kind == PROGRESS:
         if len(payload) < _PROGRESS.size:
             raise ProtocolError("PROGRESS payload too short (%d bytes)" % len(payload))
@@ -180,13 +224,14 @@ def decode(kind, payload):
 class FrameReader:
     """Reads frames from a binary stream and yields message objects.
 
-    The first frame must be a HELLO carrying the magic and protocol version 1;
+    The first frame must be a HELLO carrying the magic and protocol version 2;
     anything else is reported as a ProtocolError with the protocol's wording.
     """
 
     def __init__(self, stream):
         self.stream = stream
         self.seen_hello = False
+        self.hello = None
         self.finished = False  # DONE or ERROR seen
 
     def read_message(self):
@@ -230,13 +275,14 @@ class FrameReader:
                         "protocol version mismatch: renderer speaks %d, add-on speaks %d"
                         % (msg.version, PROTOCOL_VERSION))
                 self.seen_hello = True
+                self.hello = msg
                 return msg
             if kind == HELLO:
                 raise ProtocolError("second HELLO frame")
             if self.finished:
                 raise ProtocolError("%s frame after the end of the render"
                                     % KIND_NAMES.get(kind, "kind %d" % kind))
-            msg = decode(kind, payload)
+            msg = decode(kind, payload, self.hello)
             if msg is None:
                 continue  # unknown kind: skipped (forward compatibility)
             if isinstance(msg, (Done, Error)):
@@ -282,8 +328,16 @@ def frame(kind, payload):
     return _HEADER.pack(kind, len(payload)) + payload
 
 
-def hello_frame(width, height, spp, tile_count, version=PROTOCOL_VERSION, magic=MAGIC):
-    return frame(HELLO, _HELLO.pack(magic, version, width, height, spp, tile_count))
+def hello_frame(width, height, spp, tile_count, version=PROTOCOL_VERSION, magic=MAGIC,
+                passes=(COMBINED,)):
+    payload = _HELLO.pack(magic, version, width, height, spp, tile_count)
+    if version >= 2:
+        payload += struct.pack("<I", len(passes))
+        for name, ids in passes:
+            for text in (name, ids):
+                b = text.encode("utf-8")
+                payload += struct.pack("<I", len(b)) + b
+    return frame(HELLO, payload)
 
 
 def tile_frame(x, y, w, h, rgba_bytes):

@@ -48,12 +48,33 @@ class TESELA_PT_render(bpy.types.Panel):
         layout.use_property_split = True
         layout.use_property_decorate = False
         s = context.scene.tesela
-        col = layout.column()
-        col.prop(s, "integrator")
-        col.prop(s, "samples")
-        col.prop(s, "max_depth")
+        # Laid out as Cycles' render properties, with Cycles' property names.
+        col = layout.column(heading="Sampling")
+        row = col.row(heading="Noise Threshold", align=True)
+        row.prop(s, "use_adaptive_sampling", text="")
+        sub = row.row()
+        sub.active = s.use_adaptive_sampling
+        sub.prop(s, "adaptive_threshold", text="")
+        col.prop(s, "samples", text="Max Samples" if s.use_adaptive_sampling else "Samples")
+        sub = col.column()
+        sub.active = s.use_adaptive_sampling
+        sub.prop(s, "adaptive_min_samples")
+        col.prop(s, "time_limit")
         col.prop(s, "seed")
+        col = layout.column(heading="Denoise")
+        col.prop(s, "use_denoising")
+        sub = col.column()
+        sub.active = s.use_denoising
+        sub.prop(s, "denoising_prefilter")
+        layout.prop(s, "denoising_store_passes")
+        col = layout.column(heading="Light Paths")
+        col.prop(s, "max_depth")
+        col = layout.column(heading="Film")
+        col.prop(context.scene.render, "film_transparent", text="Transparent")
+        col = layout.column(heading="Performance")
         col.prop(s, "threads")
+        col = layout.column(heading="Debug")
+        col.prop(s, "integrator")
         path, tried = preferences.find_renderer(context)
         if path is None:
             box = layout.box()

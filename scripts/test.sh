@@ -2,6 +2,7 @@
 # Runs every test of the project on a fresh machine, installing what the tests need:
 #   - Debian's Blender 3.4 (+ python3-numpy, Xvfb for its GUI) and the Khronos glTF validator (npm),
 #   - a virtual environment .venv with PyPI's bpy (Blender 5.x as a Python module), numpy, pytest,
+#     OpenEXR (reads the multi-layer EXRs of the pass tests),
 # then: cargo fmt --check, cargo clippy -D warnings, cargo test, and pytest tests/blender.
 # Set TESELA_SKIP_INSTALL=1 to skip the installation steps.
 set -euo pipefail
@@ -22,8 +23,8 @@ if [[ "${TESELA_SKIP_INSTALL:-0}" != 1 ]]; then
         log "creating .venv (bpy, numpy, pytest)"
         python3 -m venv .venv
     fi
-    if ! .venv/bin/python -c 'import bpy, numpy, pytest' 2>/dev/null; then
-        .venv/bin/pip install -q --disable-pip-version-check bpy numpy pytest
+    if ! .venv/bin/python -c 'import bpy, numpy, pytest, OpenEXR' 2>/dev/null; then
+        .venv/bin/pip install -q --disable-pip-version-check bpy numpy pytest OpenEXR
     fi
     if command -v npm >/dev/null && [[ ! -x .venv/node/node_modules/.bin/gltf_validator ]]; then
         log "installing the Khronos glTF validator (npm)"

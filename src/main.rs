@@ -119,6 +119,26 @@ struct RenderArgs {
     /// Mapping node between Texture Coordinate and the Environment Texture, as in Blender).
     #[arg(long, value_name = "DEG", requires = "env", allow_hyphen_values = true)]
     env_rotation: Option<f32>,
+    /// Auxiliary passes, comma-separated: depth, mist, normal, position, uv, object_index,
+    /// material_index, emission, environment, denoising_normal, denoising_albedo (Cycles'
+    /// passes of those names). An .exr output becomes multi-layer with Blender's layer and
+    /// channel names (ViewLayer.Depth.Z, ...); with --pipe they travel in the tiles
+    /// (protocol version 2).
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    passes: Vec<String>,
+    /// Adaptive sampling with noise threshold T (Cycles' "Noise Threshold"; 0 = automatic):
+    /// each pixel stops once its noise estimate falls below T, up to --spp samples.
+    #[arg(long, value_name = "T", allow_hyphen_values = true)]
+    adaptive_threshold: Option<f32>,
+    /// Samples every pixel takes before adaptive sampling may stop it (0 = automatic).
+    #[arg(long, value_name = "N", requires = "adaptive_threshold")]
+    adaptive_min_samples: Option<u32>,
+    /// Stop after the sample round that passes S seconds of rendering (0 = no limit).
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    time_limit: Option<f64>,
+    /// The pipe protocol version to speak with --pipe (1 or 2; docs/protocol.md).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pipe_version: u32,
     /// A constant world of linear RGB radiance R G B, replacing the scene's world.
     #[arg(long, num_args = 3, value_names = ["R", "G", "B"])]
     background: Option<Vec<f32>>,
@@ -260,8 +280,39 @@ fn options(args: &RenderArgs, scene: &Scene) -> RenderOptions {
         threads: args.threads,
         tile_size: args.tile_size,
         region: args.region.as_ref().map(|r| [r[0], r[1], r[2], r[3]]),
-        ..Default::default()
+        passes: tesela::film::PassSet::parse(args.passes.iter().map(String::as_str))
+            .unwrap_or_default(),
+        adaptive: args
+            .adaptive_threshold
+            .map(|threshold| tesela::film::Adaptive {
+                threshold,
+                min_samples: args.adaptive_min_samples.unwrap_or(0),
+            }),
+        time_limit: args.time_limit,
     }
+}
+
+/// Checks the film options clap cannot (pass names).
+fn check_film_args(args: &RenderArgs) -> Result<(), String> {
+    tesela::film::PassSet::parse(args.passes.iter().map(String::as_str))
+        .map(|_| ())
+        .map_err(|e| format!("--passes: {e}"))
+}
+
+/// One tile as protocol frames carry it: RGBA only (version 1), or RGBA and then each pass
+/// in turn (version 2).
+fn tile_data(t: &render::Tile, passes: &tesela::film::PassSet, version: u32) -> Vec<f32> {
+    let mut data: Vec<f32> = t.pixels.iter().flatten().copied().collect();
+    if version >= 2 {
+        let stride = passes.stride();
+        for (pass, at) in passes.iter() {
+            let k = pass.channels();
+            for r in t.aovs.chunks_exact(stride.max(1)) {
+                data.extend_from_slice(&r[at..at + k]);
+            }
+        }
+    }
+    data
 }
 
 /// Pipe mode: frames on stdout, stop when stdin closes.
@@ -277,10 +328,6 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
         }
         CANCEL.store(true, Ordering::SeqCst);
     });
-    if let Err(e) = check_world_args(args) {
-        eprintln!("tesela: error: {e}");
-        return ExitCode::from(EXIT_USAGE);
-    }
     let out = Mutex::new(BufWriter::with_capacity(1 << 20, std::io::stdout()));
     let send = |m: &Message| {
         let mut o = out.lock().unwrap_or_else(|e| e.into_inner());
@@ -289,6 +336,28 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
             CANCEL.store(true, Ordering::SeqCst);
         }
     };
+    let version = args.pipe_version;
+    if version != protocol::VERSION && version != protocol::VERSION_1 {
+        let e = format!(
+            "protocol version mismatch: the add-on asks for version {version}, this renderer speaks {} and {}",
+            protocol::VERSION_1,
+            protocol::VERSION
+        );
+        eprintln!("tesela: error: {e}");
+        send(&Message::Error(e));
+        return ExitCode::from(EXIT_USAGE);
+    }
+    if let Err(e) = check_world_args(args).and_then(|_| check_film_args(args)) {
+        eprintln!("tesela: error: {e}");
+        send(&Message::Error(e));
+        return ExitCode::from(EXIT_USAGE);
+    }
+    if version < 2 && !args.passes.is_empty() {
+        let e = "--passes needs --pipe-version 2 (version 1 tiles carry RGBA only)".to_string();
+        eprintln!("tesela: error: {e}");
+        send(&Message::Error(e));
+        return ExitCode::from(EXIT_USAGE);
+    }
     let scene = match load_scene(args) {
         Ok(s) => s,
         Err(e) => {
@@ -305,12 +374,20 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
     let rscene = prepare(scene, light_choice(args), opts.threads);
     let [_, _, rw, rh] = opts.region.unwrap_or([0, 0, opts.width, opts.height]);
     let ts = opts.tile_size.max(1);
+    let mut passes = Vec::new();
+    if version >= 2 {
+        passes.push(("Combined".to_string(), "RGBA".to_string()));
+        for (p, _) in opts.passes.iter() {
+            passes.push((p.blender_name().to_string(), p.channel_ids().to_string()));
+        }
+    }
     send(&Message::Hello {
-        version: protocol::VERSION,
+        version,
         width: rw,
         height: rh,
         spp: opts.spp,
         tile_count: rw.div_ceil(ts) * rh.div_ceil(ts),
+        passes,
     });
     for w in &rscene.scene.warnings {
         send(&Message::Log {
@@ -326,18 +403,17 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
     }
     let start = std::time::Instant::now();
     let on_tile = |t: &render::Tile, done: usize, total: usize| {
-        let rgba = t.pixels.iter().flatten().copied().collect();
         send(&Message::Tile {
             x: t.x,
             y: t.y,
             w: t.w,
             h: t.h,
-            rgba,
+            data: tile_data(t, &opts.passes, version),
         });
         send(&Message::Progress {
             tiles_done: done as u32,
             tiles_total: total as u32,
-            spp: opts.spp,
+            spp: t.spp,
             elapsed: start.elapsed().as_secs_f64(),
         });
     };
@@ -383,7 +459,7 @@ fn light_choice(args: &RenderArgs) -> LightChoice {
 }
 
 fn run_render(args: &RenderArgs) -> ExitCode {
-    if let Err(e) = check_world_args(args) {
+    if let Err(e) = check_world_args(args).and_then(|_| check_film_args(args)) {
         eprintln!("tesela: error: {e}");
         return ExitCode::from(EXIT_USAGE);
     }
@@ -462,6 +538,12 @@ fn run_render(args: &RenderArgs) -> ExitCode {
                         String::new()
                     }
                 );
+                if opts.adaptive.is_some() || opts.time_limit.is_some_and(|t| t > 0.0) {
+                    eprintln!(
+                        "tesela: samples per pixel reached: {} to {} (mean {:.1}) in {} rounds; noise level {:.4}",
+                        stats.spp_min, stats.spp_max, stats.spp_mean, stats.rounds, stats.noise
+                    );
+                }
             }
             ExitCode::SUCCESS
         }

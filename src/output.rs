@@ -18,7 +18,47 @@ pub fn srgb_encode(c: f32) -> f32 {
     }
 }
 
-/// Writes `image` to `path` (`.exr` or `.png`).
+/// The view layer name of multi-layer EXR channels (`ViewLayer.Depth.Z`), Blender's default.
+pub const VIEW_LAYER: &str = "ViewLayer";
+
+/// Writes `image` with its passes as a multi-layer OpenEXR file, channels named as Blender
+/// names them (`ViewLayer.Combined.R`, `ViewLayer.Depth.Z`, `ViewLayer.Denoising Normal.X`),
+/// so Blender's image editor and compositor open it as render layers.
+fn write_multilayer(image: &Image, path: &Path) -> Result<(), String> {
+    use exr::prelude::*;
+    let (w, h) = (image.width as usize, image.height as usize);
+    let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = Default::default();
+    for (c, id) in "RGBA".chars().enumerate() {
+        let v: Vec<f32> = image.pixels.iter().map(|p| p[c]).collect();
+        channels.push(AnyChannel::new(
+            format!("{VIEW_LAYER}.Combined.{id}").as_str(),
+            FlatSamples::F32(v),
+        ));
+    }
+    let stride = image.passes.stride();
+    for (pass, at) in image.passes.iter() {
+        for (c, id) in pass.channel_ids().chars().enumerate() {
+            let v: Vec<f32> = image.aovs.chunks_exact(stride).map(|r| r[at + c]).collect();
+            channels.push(AnyChannel::new(
+                format!("{VIEW_LAYER}.{}.{id}", pass.blender_name()).as_str(),
+                FlatSamples::F32(v),
+            ));
+        }
+    }
+    let layer = Layer::new(
+        (w, h),
+        LayerAttributes::default(),
+        Encoding::FAST_LOSSLESS,
+        AnyChannels::sort(channels),
+    );
+    exr::image::Image::from_layer(layer)
+        .write()
+        .to_file(path)
+        .map_err(|e| format!("{}: cannot write EXR: {e}", path.display()))
+}
+
+/// Writes `image` to `path` (`.exr` or `.png`). With passes, an EXR is multi-layer; a PNG
+/// holds Combined only.
 pub fn write(image: &Image, path: &Path) -> Result<(), String> {
     let ext = path
         .extension()
@@ -26,6 +66,7 @@ pub fn write(image: &Image, path: &Path) -> Result<(), String> {
         .map(|e| e.to_ascii_lowercase());
     let shown = path.display();
     match ext.as_deref() {
+        Some("exr") if !image.passes.is_empty() => write_multilayer(image, path),
         Some("exr") => {
             let w = image.width as usize;
             exr::prelude::write_rgba_file(path, w, image.height as usize, |x, y| {

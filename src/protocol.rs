@@ -3,7 +3,10 @@
 
 use std::io::{self, Read, Write};
 
-pub const VERSION: u32 = 1;
+/// The newest version this renderer speaks; it also speaks [`VERSION_1`] (the default, so an
+/// add-on that does not ask still understands it).
+pub const VERSION: u32 = 2;
+pub const VERSION_1: u32 = 1;
 pub const MAGIC: &[u8; 4] = b"TSLA";
 /// Largest payload a reader accepts.
 pub const MAX_PAYLOAD: u32 = 1 << 30;
@@ -24,13 +27,18 @@ pub enum Message {
         height: u32,
         spp: u32,
         tile_count: u32,
+        /// Version 2: every pass a tile carries, in order, as (Blender pass name, channel
+        /// ids); the first is `("Combined", "RGBA")`. Empty in version 1 (RGBA only).
+        passes: Vec<(String, String)>,
     },
     Tile {
         x: u32,
         y: u32,
         w: u32,
         h: u32,
-        rgba: Vec<f32>,
+        /// Version 1: `w·h` RGBA pixels. Version 2: each pass of HELLO in turn, `w·h` pixels
+        /// of its channels.
+        data: Vec<f32>,
     },
     Progress {
         tiles_done: u32,
@@ -69,15 +77,25 @@ pub fn write(out: &mut impl Write, msg: &Message) -> io::Result<()> {
             height,
             spp,
             tile_count,
+            passes,
         } => {
             let mut p = MAGIC.to_vec();
             p.extend(u32s(&[*version, *width, *height, *spp, *tile_count]));
+            if *version >= 2 {
+                p.extend(u32s(&[passes.len() as u32]));
+                for (name, channels) in passes {
+                    for text in [name, channels] {
+                        p.extend(u32s(&[text.len() as u32]));
+                        p.extend_from_slice(text.as_bytes());
+                    }
+                }
+            }
             frame(out, HELLO, &p)
         }
-        Message::Tile { x, y, w, h, rgba } => {
+        Message::Tile { x, y, w, h, data } => {
             let mut p = u32s(&[*x, *y, *w, *h]);
-            p.reserve(rgba.len() * 4);
-            for v in rgba {
+            p.reserve(data.len() * 4);
+            for v in data {
                 p.extend_from_slice(&v.to_le_bytes());
             }
             frame(out, TILE, &p)
@@ -149,26 +167,55 @@ pub fn read(input: &mut impl Read) -> io::Result<Option<Message>> {
                 return Err(bad("not a Tesela renderer (bad magic)"));
             }
             let v = &p[4..];
+            let version = le_u32(v, 0);
+            let mut passes = Vec::new();
+            if version == 2 {
+                let mut at = 24;
+                let next_u32 = |at: &mut usize| -> io::Result<u32> {
+                    if p.len() < *at + 4 {
+                        return Err(bad("HELLO pass list truncated"));
+                    }
+                    let x = le_u32(&p[*at..], 0);
+                    *at += 4;
+                    Ok(x)
+                };
+                let count = next_u32(&mut at)?;
+                for _ in 0..count.min(1024) {
+                    let mut texts = [String::new(), String::new()];
+                    for t in &mut texts {
+                        let n = next_u32(&mut at)? as usize;
+                        if p.len() < at + n {
+                            return Err(bad("HELLO pass list truncated"));
+                        }
+                        *t = String::from_utf8_lossy(&p[at..at + n]).into_owned();
+                        at += n;
+                    }
+                    let [name, channels] = texts;
+                    passes.push((name, channels));
+                }
+            }
             Message::Hello {
-                version: le_u32(v, 0),
+                version,
                 width: le_u32(v, 1),
                 height: le_u32(v, 2),
                 spp: le_u32(v, 3),
                 tile_count: le_u32(v, 4),
+                passes,
             }
         }
         TILE => {
             need(16)?;
             let (x, y, w, h) = (le_u32(&p, 0), le_u32(&p, 1), le_u32(&p, 2), le_u32(&p, 3));
-            let n = w as u64 * h as u64 * 4;
-            if (p.len() as u64 - 16) != n * 4 {
+            let n = w as u64 * h as u64;
+            let floats = (p.len() as u64 - 16) / 4;
+            if !(p.len() - 16).is_multiple_of(4) || n == 0 || !floats.is_multiple_of(n) {
                 return Err(bad("tile payload size does not match its size"));
             }
-            let rgba = p[16..]
+            let data = p[16..]
                 .chunks_exact(4)
                 .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
                 .collect();
-            Message::Tile { x, y, w, h, rgba }
+            Message::Tile { x, y, w, h, data }
         }
         PROGRESS => {
             need(20)?;
@@ -202,18 +249,38 @@ mod tests {
     fn round_trip_every_kind() {
         let msgs = vec![
             Message::Hello {
+                version: VERSION_1,
+                width: 3,
+                height: 2,
+                spp: 4,
+                tile_count: 1,
+                passes: vec![],
+            },
+            Message::Hello {
                 version: VERSION,
                 width: 3,
                 height: 2,
                 spp: 4,
                 tile_count: 1,
+                passes: vec![
+                    ("Combined".into(), "RGBA".into()),
+                    ("Depth".into(), "Z".into()),
+                    ("Denoising Normal".into(), "XYZ".into()),
+                ],
             },
             Message::Tile {
                 x: 0,
                 y: 1,
                 w: 2,
                 h: 1,
-                rgba: vec![1.0, 2.0, 3.0, 1.0, 0.5, 0.25, 0.0, 1.0],
+                data: vec![1.0, 2.0, 3.0, 1.0, 0.5, 0.25, 0.0, 1.0],
+            },
+            Message::Tile {
+                x: 0,
+                y: 1,
+                w: 2,
+                h: 1,
+                data: vec![1.0, 2.0, 3.0, 1.0, 0.5, 0.25, 0.0, 1.0, 7.0, 8.0],
             },
             Message::Progress {
                 tiles_done: 1,

@@ -194,6 +194,12 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     if render_settings is not None:
         ext_root["TESELA_render"] = dict(
             render_settings, film_transparent=bool(getattr(scene.render, "film_transparent", False)))
+        mist = getattr(scene.world, "mist_settings", None) if scene.world is not None else None
+        if mist is not None:
+            falloff = {"QUADRATIC": 2.0, "LINEAR": 1.0, "INVERSE_QUADRATIC": 0.5}
+            ext_root["TESELA_render"]["mist"] = {
+                "start": float(mist.start), "depth": float(mist.depth),
+                "falloff": falloff.get(mist.falloff, 2.0)}
         used_ext.add("TESELA_render")
     if khr_lights:
         ext_root["KHR_lights_punctual"] = {"lights": khr_lights}

@@ -609,6 +609,8 @@ def export_material(material, warnings, textures, images, report):
     TESELA_material_graph extension beside it."""
     graph = MaterialGraph(material, images, report)
     ext = graph.build()
+    if getattr(material, "pass_index", 0):
+        ext["pass_index"] = int(material.pass_index)  # the Material Index pass
     # The fallback's own shortcomings concern other tools only: Tesela renders the graph.
     out = convert_material(material, [], textures)
     out.setdefault("extensions", {})["TESELA_material_graph"] = ext

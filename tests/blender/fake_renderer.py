@@ -45,7 +45,8 @@ def parse_args(argv):
             opts["region"] = [int(v) for v in argv[i + 1:i + 5]]
             i += 5
         elif a in ("--integrator", "--spp", "--max-depth", "--width", "--height",
-                   "--seed", "--threads"):
+                   "--seed", "--threads", "--pipe-version", "--passes", "--adaptive-threshold",
+                   "--adaptive-min-samples", "--time-limit"):
             opts[a[2:].replace("-", "_")] = argv[i + 1]
             i += 2
         else:
@@ -125,11 +126,19 @@ def main():
         out.flush()
         sys.exit(3)
 
-    version = 7 if mode == "version" else 1
+    version = 7 if mode == "version" else 2
     tile = int(os.environ.get("FAKE_TESELA_TILE", "16"))
     tiles = [(x, y, min(tile, rw - x), min(tile, rh - y))
              for y in range(0, rh, tile) for x in range(0, rw, tile)]
-    out.write(frame(1, b"TSLA" + struct.pack("<IIIII", version, rw, rh, spp, len(tiles))))
+    if mode == "oldcli":
+        # A renderer from before protocol 2: clap refuses the option it does not know.
+        sys.stderr.write("error: unexpected argument '--pipe-version' found\n\n"
+                         "Usage: tesela render [OPTIONS] [SCENE]\n")
+        sys.exit(2)
+    hello = b"TSLA" + struct.pack("<IIIII", version, rw, rh, spp, len(tiles))
+    if version == 2:
+        hello += struct.pack("<II", 1, 8) + b"Combined" + struct.pack("<I", 4) + b"RGBA"
+    out.write(frame(1, hello))
     out.flush()
     if mode == "errorhang":
         # Reports an error, then neither exits nor honours stdin EOF or SIGTERM.

@@ -250,10 +250,30 @@ def test_reader_parses_frames_and_skips_unknown_kinds():
     assert msgs[3].elapsed == 0.5 and msgs[4].stats["samples"] == 48
 
 
+def test_reader_splits_tiles_into_the_announced_passes():
+    passes = [protocol.COMBINED, ("Depth", "Z"), ("Normal", "XYZ")]
+    rgba = np.arange(2 * 3 * 4, dtype=np.float32)
+    depth = 100 + np.arange(2 * 3, dtype=np.float32)
+    normal = 200 + np.arange(2 * 3 * 3, dtype=np.float32)
+    data = (protocol.hello_frame(3, 2, 8, 1, passes=passes)
+            + protocol.tile_frame(0, 0, 3, 2, rgba.tobytes() + depth.tobytes() + normal.tobytes())
+            + protocol.done_frame("{}"))
+    hello, tile, _ = _read_all(data)
+    assert hello.passes == passes
+    assert np.array_equal(tile.pixels.reshape(-1), rgba)
+    assert tile.passes["Depth"].shape == (2, 3, 1)
+    assert np.array_equal(tile.passes["Depth"].reshape(-1), depth)
+    assert np.array_equal(tile.passes["Normal"].reshape(-1), normal)
+
+
 @pytest.mark.parametrize("data, message", [
     (b"hello world, I am not a renderer", "bad magic"),
     (protocol.frame(1, b"XXXX" + bytes(20)), "bad magic"),
-    (protocol.hello_frame(4, 4, 1, 1, version=2), "renderer speaks 2, add-on speaks 1"),
+    (protocol.hello_frame(4, 4, 1, 1, version=1), "renderer speaks 1, add-on speaks 2"),
+    (protocol.frame(1, protocol.hello_frame(4, 4, 1, 1)[8:-6]), "HELLO pass list truncated"),
+    (protocol.hello_frame(4, 4, 1, 1, passes=[("Depth", "Z")]), "does not start with Combined"),
+    (protocol.hello_frame(2, 1, 1, 1, passes=[protocol.COMBINED, ("Depth", "Z")])
+     + protocol.tile_frame(0, 0, 2, 1, bytes(2 * 4 * 4)), "expected 56"),
     (protocol.hello_frame(4, 4, 1, 1) + protocol.tile_frame(0, 0, 4, 4, bytes(256))[:100],
      "truncated TILE frame"),
     (protocol.hello_frame(4, 4, 1, 1) + b"\x02\x00\x00", "truncated frame header"),
@@ -333,7 +353,8 @@ FAULTS = [
     ("die", "SIGKILL", True),
     ("truncated", "truncated TILE frame", True),
     ("garbage", "not a Tesela renderer (bad magic)", False),
-    ("version", "protocol version mismatch: renderer speaks 7, add-on speaks 1", False),
+    ("version", "protocol version mismatch: renderer speaks 7, add-on speaks 2", False),
+    ("oldcli", "older than this add-on", False),
     ("errorhang", "device lost (fake)", False),
 ]
 
@@ -678,7 +699,8 @@ def _cli_render(tesela_bin, gltf, args):
     import io
     import threading
     # stdin stays open until the renderer is done (its EOF means "cancel").
-    proc = subprocess.Popen([str(tesela_bin), "render", str(gltf), "--pipe"] + args,
+    proc = subprocess.Popen([str(tesela_bin), "render", str(gltf), "--pipe", "--pipe-version",
+                             str(protocol.PROTOCOL_VERSION)] + args,
                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     out = {}
     readers = [threading.Thread(target=lambda k, f: out.__setitem__(k, f.read()), args=(k, f))

@@ -543,6 +543,7 @@ def render_tesela(tmp_path, bounces, spp):
     scenes.configure_cycles(scene, SIZE, SIZE, 1, bounces, seed=7)  # resolution etc.
     scene.render.engine = "TESELA"
     t = scene.tesela
+    t.use_adaptive_sampling = t.use_denoising = False  # fixed spp, as the reference
     t.integrator, t.samples, t.max_depth, t.seed = "path_mis", spp, bounces + 2, 1
     t.threads = int(os.environ.get("TESELA_TEST_THREADS", "0"))
     assert bpy.ops.render.render() == {"FINISHED"}

@@ -1207,6 +1207,7 @@ def render_both(tmp_path, spp, seeds=(1, 2), mode="emission"):
     ref = imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
     scene.render.engine = "TESELA"
     t = scene.tesela
+    t.use_adaptive_sampling = t.use_denoising = False  # fixed spp, as the reference
     if mode == "diffuse":
         t.integrator, t.samples, t.max_depth = "path_mats", spp, 2
     else:
