@@ -287,5 +287,9 @@ fn denoising_is_deterministic_across_thread_counts() {
         .denoise(&input(&noisy, Some(&albedo), None), true)
         .unwrap();
     assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
-    assert!(one.describe().contains("1 threads") || one.describe().contains("1 thread"));
+    assert!(
+        one.describe().contains("CPU device, 1 thread)"),
+        "{}",
+        one.describe()
+    );
 }

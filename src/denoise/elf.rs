@@ -72,3 +72,30 @@ pub fn check_length(path: &Path) -> Result<(), String> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn whole_elf_files_pass_and_cut_ones_fail() {
+        let dir = std::env::temp_dir().join(format!("tesela-elf-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // This test's own executable is a complete ELF file.
+        let exe = std::env::current_exe().unwrap();
+        assert_eq!(check_length(&exe), Ok(()));
+        let bytes = std::fs::read(&exe).unwrap();
+        for cut in [bytes.len() - 1, bytes.len() / 2, 100] {
+            let p = dir.join(format!("cut{cut}"));
+            std::fs::write(&p, &bytes[..cut]).unwrap();
+            let e = check_length(&p).unwrap_err();
+            assert!(e.contains(&format!("({cut} bytes")), "{e}");
+        }
+        // Not ELF, or absent: left to the loader.
+        let text = dir.join("text.so");
+        std::fs::write(&text, b"not a library").unwrap();
+        assert_eq!(check_length(&text), Ok(()));
+        assert_eq!(check_length(&dir.join("absent.so")), Ok(()));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

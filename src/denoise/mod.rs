@@ -306,6 +306,7 @@ impl Denoiser {
         };
         let threads = match self.threads {
             0 => "all threads".to_string(),
+            1 => "1 thread".to_string(),
             n => format!("{n} threads"),
         };
         format!(
