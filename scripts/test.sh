@@ -3,6 +3,7 @@
 #   - Debian's Blender 3.4 (+ python3-numpy, Xvfb for its GUI) and the Khronos glTF validator (npm),
 #   - a virtual environment .venv with PyPI's bpy (Blender 5.x as a Python module), numpy, pytest,
 #     OpenEXR (reads the multi-layer EXRs of the pass tests),
+#     and pyoidn (its Open Image Denoise library, which the renderer loads at run time),
 # then: cargo fmt --check, cargo clippy -D warnings, cargo test, and pytest tests/blender.
 # Set TESELA_SKIP_INSTALL=1 to skip the installation steps.
 set -euo pipefail
@@ -26,11 +27,25 @@ if [[ "${TESELA_SKIP_INSTALL:-0}" != 1 ]]; then
     if ! .venv/bin/python -c 'import bpy, numpy, pytest, OpenEXR' 2>/dev/null; then
         .venv/bin/pip install -q --disable-pip-version-check bpy numpy pytest OpenEXR
     fi
+    if ! .venv/bin/python -c 'import importlib.metadata as m; m.version("pyoidn")' 2>/dev/null; then
+        log "installing pyoidn (Open Image Denoise) into .venv"
+        .venv/bin/pip install -q --disable-pip-version-check pyoidn \
+            || echo "warning: pip could not install pyoidn; denoising tests will skip"
+    fi
     if command -v npm >/dev/null && [[ ! -x .venv/node/node_modules/.bin/gltf_validator ]]; then
         log "installing the Khronos glTF validator (npm)"
         mkdir -p .venv/node
         npm install -s --prefix .venv/node gltf-validator >/dev/null 2>&1 \
             || echo "warning: npm could not install gltf-validator; validator tests will skip"
+    fi
+fi
+
+# The denoiser library for the tests and the renderer they start (unless one is chosen already).
+if [[ -z "${TESELA_OIDN_LIB:-}" ]]; then
+    OIDN_LIB="$(.venv/bin/python -c 'import importlib.util as u, os; s = u.find_spec("pyoidn")
+print(os.path.join(os.path.dirname(s.origin), "oidn", "lib") if s else "")' 2>/dev/null || true)"
+    if [[ -n "$OIDN_LIB" && -d "$OIDN_LIB" ]]; then
+        export TESELA_OIDN_LIB="$OIDN_LIB"
     fi
 fi
 
