@@ -199,6 +199,8 @@ def renderer_args(binary, gltf, settings, width, height, region, pass_names=()):
     if getattr(settings, "use_adaptive_sampling", False):
         args += ["--adaptive-threshold", repr(float(settings.adaptive_threshold)),
                  "--adaptive-min-samples", str(settings.adaptive_min_samples)]
+    if getattr(settings, "use_denoising", False):
+        args += ["--denoise", "--denoise-prefilter", settings.denoising_prefilter.lower()]
     if getattr(settings, "time_limit", 0.0) > 0.0:
         args += ["--time-limit", repr(float(settings.time_limit))]
     return args

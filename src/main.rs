@@ -136,6 +136,20 @@ struct RenderArgs {
     /// Stop after the sample round that passes S seconds of rendering (0 = no limit).
     #[arg(long, value_name = "S", allow_hyphen_values = true)]
     time_limit: Option<f64>,
+    /// Denoise the final image with Intel Open Image Denoise, guided by the albedo and normal
+    /// of the first surfaces (rendered for it). Without the library: a warning, and the image
+    /// stays as rendered.
+    #[arg(long)]
+    denoise: bool,
+    /// How the denoiser treats its albedo and normal guides: accurate (denoises them first,
+    /// Cycles' default) or fast / none (uses them as rendered).
+    #[arg(long, default_value = "accurate", value_parser = ["accurate", "fast", "none"])]
+    denoise_prefilter: String,
+    /// The Open Image Denoise library (libOpenImageDenoise.so or its folder). Default: the
+    /// environment variable TESELA_OIDN_LIB, then beside the executable (and ../lib), then a
+    /// Python environment with pyoidn, then the system's library path.
+    #[arg(long, value_name = "PATH")]
+    oidn_lib: Option<PathBuf>,
     /// The pipe protocol version to speak with --pipe (1 or 2; docs/protocol.md).
     #[arg(long, default_value_t = 1, value_name = "N")]
     pipe_version: u32,
@@ -292,6 +306,47 @@ fn options(args: &RenderArgs, scene: &Scene) -> RenderOptions {
     }
 }
 
+/// Loads the denoiser when `--denoise` asks for it and adds the guide passes it needs to
+/// `opts`. A library that cannot be used is a warning (returned), not an error: the render
+/// goes on without denoising.
+fn setup_denoiser(
+    args: &RenderArgs,
+    opts: &mut RenderOptions,
+) -> (Option<tesela::denoise::Denoiser>, Option<String>) {
+    if !args.denoise {
+        return (None, None);
+    }
+    match tesela::denoise::Denoiser::load(args.oidn_lib.as_deref(), opts.threads) {
+        Ok(d) => {
+            use tesela::film::{Pass, PassSet};
+            let old = opts.passes.clone();
+            opts.passes = PassSet::new(Pass::ALL.into_iter().filter(|&p| {
+                old.contains(p) || p == Pass::DenoisingAlbedo || p == Pass::DenoisingNormal
+            }));
+            (Some(d), None)
+        }
+        Err(e) => (None, Some(format!("{e}; rendering without denoising"))),
+    }
+}
+
+/// Denoises the finished image and drops the guide passes nobody asked for. Returns what to
+/// tell the user: the denoiser used, or why the image stays noisy.
+fn finish_denoise(
+    args: &RenderArgs,
+    image: &mut render::Image,
+    denoiser: Option<&tesela::denoise::Denoiser>,
+) -> Option<Result<String, String>> {
+    let d = denoiser?;
+    let result = image
+        .denoise(d, args.denoise_prefilter == "accurate")
+        .map(|_| format!("denoised with {}", d.describe()))
+        .map_err(|e| format!("{e}; the image is not denoised"));
+    let asked =
+        tesela::film::PassSet::parse(args.passes.iter().map(String::as_str)).unwrap_or_default();
+    image.retain_passes(&asked);
+    Some(result)
+}
+
 /// Checks the film options clap cannot (pass names).
 fn check_film_args(args: &RenderArgs) -> Result<(), String> {
     tesela::film::PassSet::parse(args.passes.iter().map(String::as_str))
@@ -301,12 +356,20 @@ fn check_film_args(args: &RenderArgs) -> Result<(), String> {
 
 /// One tile as protocol frames carry it: RGBA only (version 1), or RGBA and then each pass
 /// in turn (version 2).
-fn tile_data(t: &render::Tile, passes: &tesela::film::PassSet, version: u32) -> Vec<f32> {
+/// `layout` is how the tile's records are laid out, `send` the passes to send.
+fn tile_data(
+    t: &render::Tile,
+    layout: &tesela::film::PassSet,
+    send: &tesela::film::PassSet,
+    version: u32,
+) -> Vec<f32> {
     let mut data: Vec<f32> = t.pixels.iter().flatten().copied().collect();
     if version >= 2 {
-        let stride = passes.stride();
-        for (pass, at) in passes.iter() {
-            let k = pass.channels();
+        let stride = layout.stride();
+        for (pass, _) in send.iter() {
+            let (Some(at), k) = (layout.offset(pass), pass.channels()) else {
+                continue;
+            };
             for r in t.aovs.chunks_exact(stride.max(1)) {
                 data.extend_from_slice(&r[at..at + k]);
             }
@@ -366,18 +429,22 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
             return ExitCode::from(EXIT_LOAD);
         }
     };
-    let opts = options(args, &scene);
+    let mut opts = options(args, &scene);
     if let Err(e) = render::validate(&opts) {
         send(&Message::Error(e.to_string()));
         return ExitCode::from(EXIT_RENDER);
     }
+    let (denoiser, denoise_warning) = setup_denoiser(args, &mut opts);
+    // What the tiles carry: the passes asked for (the denoiser's guides stay internal).
+    let tile_passes =
+        tesela::film::PassSet::parse(args.passes.iter().map(String::as_str)).unwrap_or_default();
     let rscene = prepare(scene, light_choice(args), opts.threads);
     let [_, _, rw, rh] = opts.region.unwrap_or([0, 0, opts.width, opts.height]);
     let ts = opts.tile_size.max(1);
     let mut passes = Vec::new();
     if version >= 2 {
         passes.push(("Combined".to_string(), "RGBA".to_string()));
-        for (p, _) in opts.passes.iter() {
+        for (p, _) in tile_passes.iter() {
             passes.push((p.blender_name().to_string(), p.channel_ids().to_string()));
         }
     }
@@ -389,7 +456,7 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
         tile_count: rw.div_ceil(ts) * rh.div_ceil(ts),
         passes,
     });
-    for w in &rscene.scene.warnings {
+    for w in rscene.scene.warnings.iter().chain(&denoise_warning) {
         send(&Message::Log {
             level: 2,
             message: w.clone(),
@@ -402,14 +469,17 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
         });
     }
     let start = std::time::Instant::now();
-    let on_tile = |t: &render::Tile, done: usize, total: usize| {
+    let send_tile = |t: &render::Tile, passes: &tesela::film::PassSet| {
         send(&Message::Tile {
             x: t.x,
             y: t.y,
             w: t.w,
             h: t.h,
-            data: tile_data(t, &opts.passes, version),
+            data: tile_data(t, passes, &tile_passes, version),
         });
+    };
+    let on_tile = |t: &render::Tile, done: usize, total: usize| {
+        send_tile(t, &opts.passes);
         send(&Message::Progress {
             tiles_done: done as u32,
             tiles_total: total as u32,
@@ -418,7 +488,23 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
         });
     };
     match render::render(&rscene, &opts, &CANCEL, &on_tile) {
-        Ok((image, stats)) => {
+        Ok((mut image, stats)) => {
+            match finish_denoise(args, &mut image, denoiser.as_ref()) {
+                Some(Ok(m)) => {
+                    send(&Message::Log {
+                        level: 1,
+                        message: m,
+                    });
+                    for t in image.tiles(ts) {
+                        send_tile(&t, &image.passes);
+                    }
+                }
+                Some(Err(m)) => send(&Message::Log {
+                    level: 2,
+                    message: m,
+                }),
+                None => {}
+            }
             if let Some(path) = &args.output
                 && let Err(e) = tesela::output::write(&image, path)
             {
@@ -470,10 +556,14 @@ fn run_render(args: &RenderArgs) -> ExitCode {
             return ExitCode::from(EXIT_LOAD);
         }
     };
-    let opts = options(args, &scene);
+    let mut opts = options(args, &scene);
     if let Err(e) = render::validate(&opts) {
         eprintln!("tesela: error: {e}");
         return ExitCode::from(EXIT_RENDER);
+    }
+    let (denoiser, denoise_warning) = setup_denoiser(args, &mut opts);
+    if let Some(w) = &denoise_warning {
+        eprintln!("tesela: warning: {w}");
     }
     let output = args
         .output
@@ -514,7 +604,12 @@ fn run_render(args: &RenderArgs) -> ExitCode {
     let result = render::render(&rscene, &opts, &CANCEL, &on_tile);
     bar.finish_and_clear();
     match result {
-        Ok((image, stats)) => {
+        Ok((mut image, stats)) => {
+            match finish_denoise(args, &mut image, denoiser.as_ref()) {
+                Some(Ok(m)) if !args.quiet => eprintln!("tesela: {m}"),
+                Some(Err(m)) => eprintln!("tesela: warning: {m}"),
+                _ => {}
+            }
             if let Err(e) = tesela::output::write(&image, &output) {
                 eprintln!("tesela: error: {e}");
                 return ExitCode::from(EXIT_RENDER);

@@ -80,6 +80,90 @@ pub struct Image {
 }
 
 impl Image {
+    /// Denoises Combined's colour in place (alpha kept) with Open Image Denoise, guided by
+    /// the Denoising Albedo and Denoising Normal passes when the image has them.
+    pub fn denoise(
+        &mut self,
+        denoiser: &crate::denoise::Denoiser,
+        prefilter: bool,
+    ) -> Result<(), crate::denoise::DenoiseError> {
+        use crate::film::Pass;
+        let color: Vec<f32> = self
+            .pixels
+            .iter()
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect();
+        let albedo = self.pass(Pass::DenoisingAlbedo);
+        let normal = self.pass(Pass::DenoisingNormal);
+        let out = denoiser.denoise(
+            &crate::denoise::Input {
+                width: self.width as usize,
+                height: self.height as usize,
+                color: &color,
+                albedo: albedo.as_deref(),
+                normal: albedo.as_ref().and(normal.as_deref()),
+            },
+            prefilter,
+        )?;
+        for (p, c) in self.pixels.iter_mut().zip(out.chunks_exact(3)) {
+            p[..3].copy_from_slice(c);
+        }
+        Ok(())
+    }
+
+    /// Keeps only the passes of `keep` (those it lists that the image has).
+    pub fn retain_passes(&mut self, keep: &PassSet) {
+        let kept = PassSet::new(
+            self.passes
+                .iter()
+                .map(|(p, _)| p)
+                .filter(|p| keep.contains(*p)),
+        );
+        if kept == self.passes {
+            return;
+        }
+        let stride = self.passes.stride();
+        let mut aovs = Vec::with_capacity(self.pixels.len() * kept.stride());
+        for r in self.aovs.chunks_exact(stride.max(1)) {
+            for (p, _) in kept.iter() {
+                let at = self.passes.offset(p).unwrap_or(0);
+                aovs.extend_from_slice(&r[at..at + p.channels()]);
+            }
+        }
+        self.aovs = if kept.is_empty() { Vec::new() } else { aovs };
+        self.passes = kept;
+    }
+
+    /// The image cut into `size`-pixel tiles, as the render streamed them.
+    pub fn tiles(&self, size: u32) -> Vec<Tile> {
+        let (w, stride) = (self.width as usize, self.passes.stride());
+        let mut tiles = Vec::new();
+        let size = size.max(1);
+        for ty in (0..self.height).step_by(size as usize) {
+            for tx in (0..self.width).step_by(size as usize) {
+                let (tw, th) = (size.min(self.width - tx), size.min(self.height - ty));
+                let mut pixels = Vec::with_capacity((tw * th) as usize);
+                let mut aovs = Vec::with_capacity((tw * th) as usize * stride);
+                for y in ty..ty + th {
+                    let row = y as usize * w;
+                    let (a, b) = (row + tx as usize, row + (tx + tw) as usize);
+                    pixels.extend_from_slice(&self.pixels[a..b]);
+                    aovs.extend_from_slice(&self.aovs[a * stride..b * stride]);
+                }
+                tiles.push(Tile {
+                    x: tx,
+                    y: ty,
+                    w: tw,
+                    h: th,
+                    pixels,
+                    aovs,
+                    spp: 0,
+                });
+            }
+        }
+        tiles
+    }
+
     /// Pass `p` as its own image: `width × height` records of `p.channels()` values.
     pub fn pass(&self, p: crate::film::Pass) -> Option<Vec<f32>> {
         let at = self.passes.offset(p)?;

@@ -57,6 +57,7 @@ fn cornell(integrator: &str, spp: u32, seed: u64) -> Vec<f32> {
         threads: 0,
         tile_size: 16,
         region: None,
+        ..Default::default()
     };
     let rs = RenderScene::new(tesela::scene::builtin::cornell_box(), LightChoice::Power);
     let (img, _) = render::render(&rs, &opts, &AtomicBool::new(false), &|_, _, _| {}).unwrap();

@@ -41,12 +41,15 @@ def parse_args(argv):
         if a == "--pipe":
             opts["pipe"] = True
             i += 1
+        elif a == "--denoise":
+            opts["denoise"] = True
+            i += 1
         elif a == "--region":
             opts["region"] = [int(v) for v in argv[i + 1:i + 5]]
             i += 5
         elif a in ("--integrator", "--spp", "--max-depth", "--width", "--height",
                    "--seed", "--threads", "--pipe-version", "--passes", "--adaptive-threshold",
-                   "--adaptive-min-samples", "--time-limit"):
+                   "--adaptive-min-samples", "--time-limit", "--denoise-prefilter"):
             opts[a[2:].replace("-", "_")] = argv[i + 1]
             i += 2
         else:
