@@ -199,6 +199,9 @@ def renderer_args(binary, gltf, settings, width, height, region, pass_names=()):
     if getattr(settings, "use_adaptive_sampling", False):
         args += ["--adaptive-threshold", repr(float(settings.adaptive_threshold)),
                  "--adaptive-min-samples", str(settings.adaptive_min_samples)]
+    filter_type = getattr(settings, "pixel_filter_type", "BOX")
+    args += ["--filter", filter_type.lower().replace("_", "-"),
+             "--filter-width", repr(float(getattr(settings, "filter_width", 1.0)))]
     if getattr(settings, "use_denoising", False):
         args += ["--denoise", "--denoise-prefilter", settings.denoising_prefilter.lower()]
     if getattr(settings, "time_limit", 0.0) > 0.0:

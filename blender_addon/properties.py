@@ -49,6 +49,15 @@ class TeselaSceneSettings(bpy.types.PropertyGroup):
                ("FAST", "Fast", "Use the albedo and normal passes as rendered"),
                ("ACCURATE", "Accurate", "Denoise the albedo and normal passes first")],
         description="How the denoiser's albedo and normal passes are treated")
+    pixel_filter_type: EnumProperty(
+        name="Pixel Filter", default="BLACKMAN_HARRIS",
+        items=[("BOX", "Box", "Box filter"),
+               ("GAUSSIAN", "Gaussian", "Gaussian filter"),
+               ("BLACKMAN_HARRIS", "Blackman-Harris", "Blackman-Harris filter")],
+        description="Pixel filter type (as Cycles' Film > Pixel Filter)")
+    filter_width: FloatProperty(
+        name="Width", default=1.5, min=0.01, max=10.0, subtype="PIXEL",
+        description="Pixel filter width")
     denoising_store_passes: BoolProperty(
         name="Denoising Data", default=False,
         description="Store the Denoising Normal and Denoising Albedo passes in the render result")

@@ -71,6 +71,8 @@ class TESELA_PT_render(bpy.types.Panel):
         col.prop(s, "max_depth")
         col = layout.column(heading="Film")
         col.prop(context.scene.render, "film_transparent", text="Transparent")
+        col.prop(s, "pixel_filter_type")
+        col.prop(s, "filter_width")
         col = layout.column(heading="Performance")
         col.prop(s, "threads")
         col = layout.column(heading="Debug")

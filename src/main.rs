@@ -150,6 +150,13 @@ struct RenderArgs {
     /// Python environment with pyoidn, then the system's library path.
     #[arg(long, value_name = "PATH")]
     oidn_lib: Option<PathBuf>,
+    /// Pixel filter (Cycles' pixel_filter_type): box, gaussian or blackman-harris.
+    #[arg(long, default_value = "box", value_parser = ["box", "gaussian", "blackman-harris"])]
+    filter: String,
+    /// Pixel filter width in pixels (Cycles' filter_width; Cycles' default is Blackman-Harris
+    /// 1.5, which spans 3 pixels).
+    #[arg(long, default_value_t = 1.0, value_name = "W")]
+    filter_width: f32,
     /// The pipe protocol version to speak with --pipe (1 or 2; docs/protocol.md).
     #[arg(long, default_value_t = 1, value_name = "N")]
     pipe_version: u32,
@@ -303,6 +310,14 @@ fn options(args: &RenderArgs, scene: &Scene) -> RenderOptions {
                 min_samples: args.adaptive_min_samples.unwrap_or(0),
             }),
         time_limit: args.time_limit,
+        filter: tesela::film::PixelFilter::new(
+            match args.filter.as_str() {
+                "gaussian" => tesela::film::FilterType::Gaussian,
+                "blackman-harris" => tesela::film::FilterType::BlackmanHarris,
+                _ => tesela::film::FilterType::Box,
+            },
+            args.filter_width,
+        ),
     }
 }
 
@@ -349,6 +364,12 @@ fn finish_denoise(
 
 /// Checks the film options clap cannot (pass names).
 fn check_film_args(args: &RenderArgs) -> Result<(), String> {
+    if !(args.filter_width.is_finite() && (0.01..=10.0).contains(&args.filter_width)) {
+        return Err(format!(
+            "--filter-width {}: the width must be between 0.01 and 10 pixels",
+            args.filter_width
+        ));
+    }
     tesela::film::PassSet::parse(args.passes.iter().map(String::as_str))
         .map(|_| ())
         .map_err(|e| format!("--passes: {e}"))

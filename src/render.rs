@@ -33,6 +33,8 @@ pub struct RenderOptions {
     pub adaptive: Option<Adaptive>,
     /// Stop after the sample round that crosses this many seconds (Cycles' time limit).
     pub time_limit: Option<f64>,
+    /// How sample positions spread over and around each pixel.
+    pub filter: crate::film::PixelFilter,
 }
 
 impl Default for RenderOptions {
@@ -50,6 +52,7 @@ impl Default for RenderOptions {
             passes: PassSet::default(),
             adaptive: None,
             time_limit: None,
+            filter: Default::default(),
         }
     }
 }
@@ -305,7 +308,11 @@ fn render_samples(
     for s in acc.next..end {
         ctx.sampler = SobolSampler::new(opts.seed, pixel_index, s as u64);
         // Dimension 0: the pixel filter; 1: the lens, only for cameras with depth of field.
-        let film = Vec2::new(px as f32, py as f32) + ctx.sampler.next_2d();
+        let u = ctx.sampler.next_2d();
+        let film = Vec2::new(
+            px as f32 + opts.filter.offset(u.x),
+            py as f32 + opts.filter.offset(u.y),
+        );
         let u_lens = if lens {
             ctx.sampler.next_2d()
         } else {

@@ -5,8 +5,10 @@
 //! thread count and any split into rounds (Combined is bit-identical to one long round).
 
 pub mod data;
+pub mod filter;
 pub mod pass;
 
+pub use filter::{FilterType, PixelFilter};
 pub use pass::{Pass, PassSet};
 
 use glam::Vec3;

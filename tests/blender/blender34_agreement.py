@@ -64,6 +64,7 @@ scenes.render_cycles(os.path.join(out_dir, "cycles.exr"))
 scene.render.engine = "TESELA"
 t = scene.tesela
 t.use_adaptive_sampling = t.use_denoising = False  # fixed spp, as the reference
+t.pixel_filter_type, t.filter_width = "BOX", 1.0  # configure_cycles' filter
 t.integrator, t.samples, t.max_depth, t.seed = integrator, spp, bounces + 2, 1
 bpy.ops.render.render(write_still=False)
 bpy.data.images["Render Result"].save_render(os.path.join(out_dir, "tesela.exr"))

@@ -49,7 +49,8 @@ def parse_args(argv):
             i += 5
         elif a in ("--integrator", "--spp", "--max-depth", "--width", "--height",
                    "--seed", "--threads", "--pipe-version", "--passes", "--adaptive-threshold",
-                   "--adaptive-min-samples", "--time-limit", "--denoise-prefilter"):
+                   "--adaptive-min-samples", "--time-limit", "--denoise-prefilter", "--filter",
+                   "--filter-width"):
             opts[a[2:].replace("-", "_")] = argv[i + 1]
             i += 2
         else:

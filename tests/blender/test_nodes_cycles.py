@@ -1208,6 +1208,7 @@ def render_both(tmp_path, spp, seeds=(1, 2), mode="emission"):
     scene.render.engine = "TESELA"
     t = scene.tesela
     t.use_adaptive_sampling = t.use_denoising = False  # fixed spp, as the reference
+    t.pixel_filter_type, t.filter_width = "BOX", 1.0  # configure_cycles' filter
     if mode == "diffuse":
         t.integrator, t.samples, t.max_depth = "path_mats", spp, 2
     else:

@@ -126,6 +126,7 @@ def renders(addon, tesela_bin, tmp_path_factory):
     scene.render.engine = "TESELA"
     t = scene.tesela
     t.use_adaptive_sampling = t.use_denoising = False
+    t.pixel_filter_type, t.filter_width = "BOX", 1.0
     t.integrator, t.samples, t.max_depth, t.seed = "direct_mis", SPP * 4, 2, 1
     got = render_multilayer(tmp / "tesela.exr")
     # The same render without passes: Combined must not change.
