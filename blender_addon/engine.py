@@ -213,6 +213,32 @@ OLD_RENDERER = ("the renderer %s is older than this add-on: it does not speak pi
                 "version %d (install the renderer that came with the add-on)")
 
 
+def format_time_left(elapsed, fraction):
+    """'Remaining mm:ss' from the time so far and the fraction done (Cycles' stats wording)."""
+    if fraction <= 0.0 or fraction >= 1.0:
+        return "Time %s" % _mmss(elapsed)
+    return "Time %s | Remaining %s" % (_mmss(elapsed), _mmss(elapsed * (1.0 - fraction) / fraction))
+
+
+def _mmss(seconds):
+    seconds = max(0, int(round(seconds)))
+    return "%02d:%02d" % divmod(seconds, 60)
+
+
+class progress_lines:
+    """When to print a progress line: every `step` of the fraction done, and at the end."""
+
+    def __init__(self, step=0.05):
+        self.step = step
+        self.next = 0.0
+
+    def due(self, fraction):
+        if fraction + 1e-9 < self.next:
+            return False
+        self.next = (int(fraction / self.step + 1e-9) + 1) * self.step
+        return True
+
+
 class TeselaRenderEngine(bpy.types.RenderEngine):
     bl_idname = "TESELA"
     bl_label = "Tesela"
@@ -384,11 +410,21 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
         last_stats = 0.0
         elapsed = 0.0
 
+        farm = progress_lines()
+
         def report_progress():
+            frac = min(1.0, tiles_done / tiles_total) if tiles_total else 0.0
             if tiles_total:
-                self.update_progress(min(1.0, tiles_done / tiles_total))
-            self.update_stats("", "Tesela | Sample %d/%d | Tile %d/%d | %.1f s" % (
-                spp_now, settings.samples, tiles_done, tiles_total, elapsed))
+                self.update_progress(frac)
+            line = "Tesela | Sample %d/%d | Tile %d/%d | %s" % (
+                spp_now, settings.samples, tiles_done, tiles_total,
+                format_time_left(elapsed, frac))
+            if farm.due(frac):
+                # Background renders: one line per few percent, for farm log parsers.
+                print("Tesela: %3d%% | %s" % (int(frac * 100), line[len("Tesela | "):]),
+                      flush=True)
+            if not bpy.app.background:
+                self.update_stats("", line)
 
         end_deadline = None
         finished = False

@@ -947,3 +947,12 @@ def test_export_selection_only(addon, tmp_path):
     doc = _export(tmp_path / "sel.gltf", use_selection=True)
     names = {n["name"] for n in doc["nodes"]}
     assert names == {"Cube", "Cam"}
+
+
+def test_progress_lines_for_farms_and_time_left():
+    lines = tesela_engine.progress_lines(step=0.05)
+    printed = [f for f in [i / 200 for i in range(201)] if lines.due(f)]
+    # One line per 5% (21 with 0% and 100%), never two for the same step.
+    assert len(printed) == 21 and printed[0] == 0.0 and printed[-1] == 1.0
+    assert tesela_engine.format_time_left(30.0, 0.25) == "Time 00:30 | Remaining 01:30"
+    assert tesela_engine.format_time_left(5.0, 1.0) == "Time 00:05"
