@@ -124,6 +124,10 @@ pub struct Ctx {
     pub log: Option<Vec<RayQuery>>,
     /// BVH traversal scratch, reused by every ray of the thread.
     pub trav: Traversal,
+    /// Where the current camera ray ends (the camera's far clip), world space; `None`: it
+    /// does not end. Camera-ray segments (path vertex 1, also past transparent surfaces)
+    /// stop there.
+    pub camera_end: Option<Vec3>,
 }
 
 impl Ctx {
@@ -137,7 +141,16 @@ impl Ctx {
             rays: 0,
             log: None,
             trav: Traversal::default(),
+            camera_end: None,
         }
+    }
+
+    /// Length left of the camera-ray segment from `o` along the unit `d` before the camera's
+    /// far clip (`f32::INFINITY` without one; never negative).
+    #[inline]
+    pub fn camera_tmax(&self, o: Vec3, d: Vec3) -> f32 {
+        self.camera_end
+            .map_or(f32::INFINITY, |end| (end - o).dot(d).max(0.0))
     }
 
     /// Counts a ray and records it if recording.
@@ -652,20 +665,33 @@ impl RenderScene {
     }
 
     /// Like [`RenderScene::intersect`] for the ray leaving path vertex `depth - 1`; camera rays
-    /// (`depth == 1`) pass through meshes hidden from the camera.
+    /// (`depth == 1`) pass through meshes hidden from the camera and end at the camera's far
+    /// clip ([`Ctx::camera_end`]).
     #[inline]
     pub fn trace(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, depth: u32) -> Option<Intersection> {
-        let mut its = self.intersect(ctx, o, d)?;
         if depth != 1 {
-            return Some(its);
+            return self.intersect(ctx, o, d);
         }
+        let mut its = self.intersect_before(ctx, o, d, ctx.camera_tmax(o, d))?;
         for _ in 0..64 {
             if !self.scene.meshes[its.mesh as usize].hidden_from_camera {
                 return Some(its);
             }
-            its = self.intersect(ctx, offset_origin(its.p, its.ng, d), d)?;
+            let o = offset_origin(its.p, its.ng, d);
+            its = self.intersect_before(ctx, o, d, ctx.camera_tmax(o, d))?;
         }
         Some(its)
+    }
+
+    /// Closest surface along the unit direction `d` from `o` nearer than `tmax`.
+    #[inline]
+    fn intersect_before(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32) -> Option<Intersection> {
+        if tmax == f32::INFINITY {
+            return self.intersect(ctx, o, d);
+        }
+        ctx.cast(o, d, tmax, RayKind::Closest);
+        let hit = self.accel.intersect_with(&mut ctx.trav, o, d, 0.0, tmax)?;
+        Some(self.intersection(&hit, d))
     }
 
     /// True when nothing blocks the segment from surface point `p` (geometric normal `ng`)
@@ -1008,6 +1034,33 @@ mod tests {
     use crate::sampler::{Sampler, SobolSampler};
     use crate::sampling::square_to_uniform_sphere;
     use crate::scene::builtin;
+
+    /// Camera rays (path vertex 1) end at `Ctx::camera_end`, also past a transparent surface
+    /// or a hidden mesh (a segment from a later origin on the same ray); other rays do not.
+    #[test]
+    fn camera_rays_end_at_the_far_clip() {
+        let rs = RenderScene::new(builtin::by_name("cornell-box").unwrap(), LightChoice::Power);
+        let mut ctx = Ctx::new(SobolSampler::new(0, 0, 0));
+        let (o, d) = (Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.0, 0.0, -1.0));
+        let wall = rs.intersect(&mut ctx, o, d).expect("the back wall").t;
+        for (end, hits) in [(0.9 * wall, false), (1.1 * wall, true)] {
+            ctx.camera_end = Some(o + d * end);
+            assert_eq!(
+                rs.trace(&mut ctx, o, d, 1).is_some(),
+                hits,
+                "end {end}, wall {wall}"
+            );
+            // A later segment of the same camera ray: the end stays where it was.
+            let o2 = o + d * (0.5 * wall);
+            assert_eq!(rs.trace(&mut ctx, o2, d, 1).is_some(), hits);
+            assert!(
+                rs.trace(&mut ctx, o, d, 2).is_some(),
+                "bounce rays are not clipped"
+            );
+        }
+        ctx.camera_end = None;
+        assert!(rs.trace(&mut ctx, o, d, 1).is_some());
+    }
 
     /// An emissive graph that reads the viewing direction and the side it is seen from
     /// (emission colour |Incoming|, strength 1 + Backfacing, on a two-sided triangle) must give

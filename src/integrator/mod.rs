@@ -398,9 +398,12 @@ pub fn trace_lit(
     let lights = if last && depth > 1 {
         scene.lights_on_ray(ctx, o, d, f32::INFINITY, depth, bsdf_pdf, true)
     } else {
-        let tmax = hit
-            .as_ref()
-            .map_or(f32::INFINITY, |its| (its.p - o).length());
+        let end = if depth == 1 {
+            ctx.camera_tmax(o, d)
+        } else {
+            f32::INFINITY
+        };
+        let tmax = hit.as_ref().map_or(end, |its| (its.p - o).length());
         scene.lights_on_ray(ctx, o, d, tmax, depth, bsdf_pdf, false)
     };
     (hit, emitted, lights)
