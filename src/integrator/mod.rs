@@ -95,6 +95,21 @@ impl ShadingPoint {
         } else if n.dot(-d) < 0.0 {
             n = -n;
         }
+        if closure.normal != Vec3::ZERO
+            && matches!(
+                bsdf,
+                BsdfInstance::Mirror(_) | BsdfInstance::RoughConductor(_)
+            )
+        {
+            // Specular reflection lobes (Glossy, metallic Principled) under a normal or bump
+            // map reflect above the geometric surface, as Cycles makes them.
+            let ng = if its.ng.dot(-d) < 0.0 {
+                -its.ng
+            } else {
+                its.ng
+            };
+            n = bsdf::closure::valid_specular_normal(ng, -d, n);
+        }
         let frame = match anisotropic_rotation(&closure.kind) {
             Some(rotation) => {
                 let t = if closure.tangent == Vec3::ZERO {
