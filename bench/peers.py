@@ -4,6 +4,7 @@
     cargo build --release                  # the tesela binary that is measured
     .venv/bin/python bench/peers.py --quick                  # smoke run, about a minute
     .venv/bin/python bench/peers.py --threads 2 --repeats 5  # the benchmark (bench/README.md)
+    .venv/bin/python bench/peers.py --addon                  # Blender scenes via the add-on
 
 Each scene of bench/scenes.py is built once as arrays and written to every peer's format (glTF for
 Tesela, bpy objects for Cycles, PLY meshes in a scene dict for Mitsuba). For each scene and mode
@@ -550,6 +551,120 @@ def merge(args):
         print(f"wrote {out}")
 
 
+# ------------------------------------------------------------------------------------------------
+# scenes through the Blender add-on (--addon): Blender node materials and worlds, as users have them
+
+ADDON_SCENES = {
+    # A rough Principled floor with a tangent-space Normal Map from an image, lit by a low sun
+    # and a dim world (tests/blender/test_material_scenes_cycles.py: normal_map).
+    "normalmap": ("test_material_scenes_cycles", "normal_map"),
+    # A diffuse and a glossy sphere on a plane under an HDRI world with a small bright sun, the
+    # sky behind them (tests/blender/test_world_cycles.py: hdri_world).
+    "hdri_product": ("test_world_cycles", "hdri_world"),
+}
+
+
+def _addon_render(engine, spp, seed):
+    """Render the current scene with `engine` ("CYCLES" or "TESELA") at `spp`: wall seconds of
+    bpy.ops.render.render (scene sync/export and BVH build included, for both)."""
+    import bpy
+    sc = bpy.context.scene
+    sc.render.engine = engine
+    if engine == "CYCLES":
+        sc.cycles.samples, sc.cycles.seed = spp, seed
+    else:
+        sc.tesela.samples, sc.tesela.seed = spp, seed
+    sys.stdout.flush()
+    saved = os.dup(1)  # Blender prints progress lines on fd 1
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)
+    try:
+        t0 = time.perf_counter()
+        assert bpy.ops.render.render() == {"FINISHED"}
+        wall = time.perf_counter() - t0
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(devnull)
+    return wall
+
+
+def _render_result_mean():
+    import bpy
+    img = bpy.data.images["Render Result"]
+    # The Render Result has no pixels in bpy until viewed: read them through a saved EXR.
+    path = Path(tempfile.mkdtemp(prefix="tesela-addon-")) / "r.exr"
+    st = bpy.context.scene.render.image_settings
+    if hasattr(st, "media_type"):
+        st.media_type = "IMAGE"
+    st.file_format, st.color_depth = "OPEN_EXR", "32"
+    img.save_render(str(path))
+    return read_exr(path).reshape(-1, 3).mean(axis=0)
+
+
+def addon_bench(args):
+    """Tesela (through the add-on, path_mis depth b + 2) against Cycles (max bounces b) on Blender
+    scenes at the same spp: median wall time of `repeats` renders in alternation, and the
+    marginal samples/s `pixels (spp - 1) / (t(spp) - t(1))`, which leaves out the per-render
+    costs (sync, export, BVH, process start) that both have."""
+    import bpy
+    tests = REPO / "tests" / "blender"
+    for path in (REPO, tests):
+        sys.path.insert(0, str(path))
+    # The test modules import their own `scenes` (tests/blender/scenes.py), not bench/scenes.py.
+    sys.modules.pop("scenes", None)
+    import importlib
+    import blender_addon
+    import scenes as bs
+    from blender_addon import engine as tesela_engine
+    if not tesela_engine.TeselaRenderEngine.is_registered:
+        blender_addon.register()
+    os.environ["TESELA_BINARY"] = str(args.tesela)
+    size = args.size or (48 if args.quick else 256)
+    spp = 4 if args.quick else args.addon_spp
+    bounces = 3
+    repeats = args.repeats or (2 if args.quick else 3)
+    lines = [f"#### Blender scenes through the add-on: {size}x{size}, {spp} spp, Cycles max "
+             f"bounces {bounces} / Tesela path_mis depth {bounces + 2}, {args.threads} threads",
+             "", "| scene | peer | median wall s | marginal samples/s | mean RGB |",
+             "| --- | --- | --- | --- | --- |"]
+    ratios = {}
+    for name in [n.strip() for n in args.addon_scenes.split(",") if n.strip()]:
+        module, builder = ADDON_SCENES[name]
+        bs.clear_scene()
+        getattr(importlib.import_module(module), builder)()
+        sc = bpy.context.scene
+        bs.configure_cycles(sc, size, size, spp, bounces, seed=1, threads=args.threads)
+        t = sc.tesela
+        t.integrator, t.max_depth, t.threads = "path_mis", bounces + 2, args.threads
+        _addon_render("TESELA", 1, 0)  # warm-up: caches, page faults
+        _addon_render("CYCLES", 1, 0)
+        walls = {"cycles": [], "tesela": []}
+        ones = {"cycles": [], "tesela": []}
+        means = {}
+        for r in range(repeats):
+            for peer, engine in (("cycles", "CYCLES"), ("tesela", "TESELA")):
+                ones[peer].append(_addon_render(engine, 1, r))
+                walls[peer].append(_addon_render(engine, spp, r))
+                means[peer] = _render_result_mean()
+        rate = {}
+        for peer in ("cycles", "tesela"):
+            w, o = statistics.median(walls[peer]), statistics.median(ones[peer])
+            rate[peer] = size * size * (spp - 1) / max(w - o, 1e-9)
+            m = ", ".join(f"{v:.4f}" for v in means[peer])
+            lines.append(f"| {name} | {peer} | {w:.2f} | {rate[peer]:,.0f} | {m} |")
+            log(f"  {name} {peer}: wall {walls[peer]} (1 spp: {ones[peer]}), mean {m}")
+        ratios[name] = (rate["tesela"] / rate["cycles"],
+                        statistics.median(walls["cycles"]) / statistics.median(walls["tesela"]))
+    lines.append("")
+    for name, (r, w) in ratios.items():
+        lines.append(f"- {name}: Tesela / Cycles marginal samples/s {r:.2f}x; "
+                     f"wall-time ratio (Cycles / Tesela) {w:.2f}x")
+    text = "\n".join(lines)
+    log("\n" + text)
+    return text
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="tiny sizes: a smoke run")
@@ -573,9 +688,21 @@ def main():
     ap.add_argument("--merge", nargs="+", metavar="JSON",
                     help="no rendering: pool the timed runs of earlier full runs' .json files "
                          "and print (and with --out, write) the combined tables")
+    ap.add_argument("--addon", action="store_true",
+                    help="only the Blender scenes through the add-on (Tesela vs Cycles, same spp)")
+    ap.add_argument("--addon-scenes", default=",".join(ADDON_SCENES))
+    ap.add_argument("--addon-spp", type=int, default=64)
     args = ap.parse_args()
     if args.merge:
         return merge(args)
+    if args.addon:
+        import bpy  # noqa: F401
+        text = addon_bench(args)
+        if args.out:
+            Path(args.out).mkdir(parents=True, exist_ok=True)
+            stamp = _dt.datetime.now(_dt.timezone.utc).strftime("%Y%m%d-%H%M")
+            (Path(args.out) / f"addon-{stamp}.md").write_text(text + "\n")
+        return None
     q = args.quick
     args.repeats = args.repeats or (2 if q else 5)
     args.budget = args.budget or (0.2 if q else 2.0)

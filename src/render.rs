@@ -322,8 +322,7 @@ fn render_samples(
             acc.empty += 1;
             continue;
         };
-        // The integrators trace camera rays without an end yet: `ray.tmax` (the far clip
-        // distance) is not applied.
+        ctx.camera_end = ray.tmax.is_finite().then(|| ray.o + ray.d * ray.tmax);
         let l = integrator.li(scene, ctx, ray.o, ray.d);
         if l.is_finite() && l.min_element() >= 0.0 {
             acc.sum += l;

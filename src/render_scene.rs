@@ -124,6 +124,10 @@ pub struct Ctx {
     pub log: Option<Vec<RayQuery>>,
     /// BVH traversal scratch, reused by every ray of the thread.
     pub trav: Traversal,
+    /// Where the current camera ray ends (the camera's far clip), world space; `None`: it
+    /// does not end. Camera-ray segments (path vertex 1, also past transparent surfaces)
+    /// stop there.
+    pub camera_end: Option<Vec3>,
 }
 
 impl Ctx {
@@ -137,7 +141,16 @@ impl Ctx {
             rays: 0,
             log: None,
             trav: Traversal::default(),
+            camera_end: None,
         }
+    }
+
+    /// Length left of the camera-ray segment from `o` along the unit `d` before the camera's
+    /// far clip (`f32::INFINITY` without one; never negative).
+    #[inline]
+    pub fn camera_tmax(&self, o: Vec3, d: Vec3) -> f32 {
+        self.camera_end
+            .map_or(f32::INFINITY, |end| (end - o).dot(d).max(0.0))
     }
 
     /// Counts a ray and records it if recording.
@@ -228,7 +241,7 @@ impl RenderScene {
             match AreaEmitter::with_program(&scene, mi, program.clone()) {
                 Some(e) => {
                     mesh_emitter[mi] = Some(emitters.len() as u32);
-                    emitters.push(EmitterInstance::Area(e));
+                    emitters.push(EmitterInstance::Area(e.with_camera(camera_to_world)));
                 }
                 None => warnings.push(format!(
                     "emissive mesh `{}` has zero area; it does not light the scene",
@@ -652,20 +665,33 @@ impl RenderScene {
     }
 
     /// Like [`RenderScene::intersect`] for the ray leaving path vertex `depth - 1`; camera rays
-    /// (`depth == 1`) pass through meshes hidden from the camera.
+    /// (`depth == 1`) pass through meshes hidden from the camera and end at the camera's far
+    /// clip ([`Ctx::camera_end`]).
     #[inline]
     pub fn trace(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, depth: u32) -> Option<Intersection> {
-        let mut its = self.intersect(ctx, o, d)?;
         if depth != 1 {
-            return Some(its);
+            return self.intersect(ctx, o, d);
         }
+        let mut its = self.intersect_before(ctx, o, d, ctx.camera_tmax(o, d))?;
         for _ in 0..64 {
             if !self.scene.meshes[its.mesh as usize].hidden_from_camera {
                 return Some(its);
             }
-            its = self.intersect(ctx, offset_origin(its.p, its.ng, d), d)?;
+            let o = offset_origin(its.p, its.ng, d);
+            its = self.intersect_before(ctx, o, d, ctx.camera_tmax(o, d))?;
         }
         Some(its)
+    }
+
+    /// Closest surface along the unit direction `d` from `o` nearer than `tmax`.
+    #[inline]
+    fn intersect_before(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32) -> Option<Intersection> {
+        if tmax == f32::INFINITY {
+            return self.intersect(ctx, o, d);
+        }
+        ctx.cast(o, d, tmax, RayKind::Closest);
+        let hit = self.accel.intersect_with(&mut ctx.trav, o, d, 0.0, tmax)?;
+        Some(self.intersection(&hit, d))
     }
 
     /// True when nothing blocks the segment from surface point `p` (geometric normal `ng`)
@@ -729,6 +755,7 @@ impl RenderScene {
             // About a tenth of a pixel at a typical field of view.
             bump_step: its.t.max(1e-3) * 1e-4,
             ray_depth: depth,
+            ray_length: its.t,
             ray_flags: flags,
         }
     }
@@ -1023,6 +1050,113 @@ mod tests {
     use crate::sampler::{Sampler, SobolSampler};
     use crate::sampling::square_to_uniform_sphere;
     use crate::scene::builtin;
+
+    /// Camera rays (path vertex 1) end at `Ctx::camera_end`, also past a transparent surface
+    /// or a hidden mesh (a segment from a later origin on the same ray); other rays do not.
+    #[test]
+    fn camera_rays_end_at_the_far_clip() {
+        let rs = RenderScene::new(builtin::by_name("cornell-box").unwrap(), LightChoice::Power);
+        let mut ctx = Ctx::new(SobolSampler::new(0, 0, 0));
+        let (o, d) = (Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.0, 0.0, -1.0));
+        let wall = rs.intersect(&mut ctx, o, d).expect("the back wall").t;
+        for (end, hits) in [(0.9 * wall, false), (1.1 * wall, true)] {
+            ctx.camera_end = Some(o + d * end);
+            assert_eq!(
+                rs.trace(&mut ctx, o, d, 1).is_some(),
+                hits,
+                "end {end}, wall {wall}"
+            );
+            // A later segment of the same camera ray: the end stays where it was.
+            let o2 = o + d * (0.5 * wall);
+            assert_eq!(rs.trace(&mut ctx, o2, d, 1).is_some(), hits);
+            assert!(
+                rs.trace(&mut ctx, o, d, 2).is_some(),
+                "bounce rays are not clipped"
+            );
+        }
+        ctx.camera_end = None;
+        assert!(rs.trace(&mut ctx, o, d, 1).is_some());
+    }
+
+    /// An emissive graph that reads the viewing direction and the side it is seen from
+    /// (emission colour |Incoming|, strength 1 + Backfacing, on a two-sided triangle) must give
+    /// the same radiance to a light sample and to a ray that hits the same point (the two MIS
+    /// strategies), and that radiance must be the analytic one.
+    #[test]
+    fn emission_graphs_see_the_same_point_from_light_samples_and_hits() {
+        use crate::emitter::{Emitter, EmitterQueryRecord};
+        use crate::shading::globals::to_blender;
+        let graph = serde_json::json!({
+            "nodes": [
+                {"type": "ShaderNodeNewGeometry"},
+                {"type": "ShaderNodeVectorMath", "props": {"operation": "ABSOLUTE"},
+                 "inputs": {"Vector": {"link": [0, "Incoming"]}}},
+                {"type": "ShaderNodeMath", "props": {"operation": "ADD"},
+                 "inputs": {"Value": {"link": [0, "Backfacing"]}, "Value_001": 1.0}},
+                {"type": "ShaderNodeEmission", "inputs": {"Color": {"link": [1, "Vector"]},
+                 "Strength": {"link": [2, "Value"]}}}
+            ],
+            "surface": [3, "Emission"]
+        });
+        let mut light = crate::scene::Material::emitter("light", Vec3::ONE, true);
+        light.graph = Some(std::sync::Arc::new(
+            crate::shading::Graph::from_json(&graph).unwrap(),
+        ));
+        let mut mesh = crate::scene::Mesh {
+            name: "light".into(),
+            ..Default::default()
+        };
+        // A tilted triangle; its normal (right-hand rule) points to +y mostly.
+        mesh.positions = vec![
+            Vec3::new(-1.0, 0.0, -1.0),
+            Vec3::new(-0.2, 0.3, 1.2),
+            Vec3::new(1.3, -0.2, -0.6),
+        ];
+        mesh.indices = vec![[0, 1, 2]];
+        let ng = (mesh.positions[1] - mesh.positions[0])
+            .cross(mesh.positions[2] - mesh.positions[0])
+            .normalize();
+        let scene = crate::scene::Scene {
+            meshes: vec![mesh],
+            materials: vec![light],
+            ..Default::default()
+        };
+        let rs = RenderScene::new(scene, LightChoice::Power);
+        let emitter = &rs.emitters[rs.mesh_emitter[0].unwrap() as usize];
+        let mut rng = Sampler::new(3, 0, 0);
+        let mut ctx = Ctx::new(SobolSampler::new(0, 0, 0));
+        let (mut front, mut back) = (0, 0);
+        for _ in 0..2000 {
+            let ref_p = (Vec3::new(rng.next_1d(), rng.next_1d(), rng.next_1d()) - 0.5) * 6.0;
+            let mut rec = EmitterQueryRecord::from_ref(ref_p);
+            let weight = emitter.sample(&rs.scene, &mut rec, rng.next_2d());
+            if rec.pdf <= 0.0 || weight == Vec3::ZERO {
+                continue;
+            }
+            let sampled = weight * rec.pdf;
+            let its = rs
+                .intersect(&mut ctx, ref_p, rec.wi)
+                .expect("the ray hits the light");
+            let (_, hit, _) = rs.emitted(&its, ref_p).unwrap();
+            let backfacing = ng.dot(rec.wi) > 0.0;
+            let expected = to_blender(-rec.wi).abs() * if backfacing { 2.0 } else { 1.0 };
+            let tol = 1e-4 * expected.max_element();
+            assert!(
+                (sampled - hit).abs().max_element() <= tol,
+                "{sampled} vs {hit}"
+            );
+            assert!(
+                (sampled - expected).abs().max_element() <= tol,
+                "{sampled} vs {expected}"
+            );
+            if backfacing {
+                back += 1;
+            } else {
+                front += 1;
+            }
+        }
+        assert!(front > 500 && back > 500, "{front} front, {back} back");
+    }
 
     /// `emission_along` must return what a full closest-hit trace returns, for rays that hit
     /// the light, rays blocked before it (by the spheres), rays that escape to the background

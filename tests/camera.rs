@@ -755,16 +755,31 @@ fn tesela_camera_carries_blender_camera_data() {
     // Without dof, or with use_dof false: a pinhole.
     let s = load_camera(json!({"type": "PERSP", "dof": {"use_dof": false}}));
     assert!(s.camera.unwrap().aperture.is_none());
-    // glTF cameras stay as they were: vertical fov, no clipping, no lens.
-    let doc = json!({"asset": {"version": "2.0"}, "nodes": [{"camera": 0}],
-        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1, "zfar": 9.0}}]});
-    let s = gltf::load_from_slice(&serde_json::to_vec(&doc).unwrap(), None, "g.gltf").unwrap();
-    let c = s.camera.unwrap();
-    assert_eq!(c.projection, Projection::Perspective { yfov: 0.5 });
-    assert_eq!(
-        (c.fit, c.clip_start, c.clip_end, c.aperture),
-        (SensorFit::Vertical, 0.0, f32::INFINITY, None)
-    );
+    // glTF cameras: vertical fov, no lens, znear/zfar as the clip distances (Blender's
+    // importer: clip_start/clip_end); without zfar no far clip.
+    for (cam, clip) in [
+        (
+            json!({"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1, "zfar": 9.0}}),
+            (0.1, 9.0),
+        ),
+        (
+            json!({"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.2}}),
+            (0.2, f32::INFINITY),
+        ),
+        (
+            json!({"type": "orthographic",
+                "orthographic": {"xmag": 1.0, "ymag": 1.0, "znear": 0.0, "zfar": 50.0}}),
+            (0.0, 50.0),
+        ),
+    ] {
+        let doc = json!({"asset": {"version": "2.0"}, "nodes": [{"camera": 0}], "cameras": [cam]});
+        let s = gltf::load_from_slice(&serde_json::to_vec(&doc).unwrap(), None, "g.gltf").unwrap();
+        let c = s.camera.unwrap();
+        assert_eq!(
+            (c.fit, c.clip_start, c.clip_end, c.aperture),
+            (SensorFit::Vertical, clip.0, clip.1, None)
+        );
+    }
 }
 
 #[test]

@@ -9,6 +9,36 @@ use super::{
 use crate::shading::{Closure, ClosureKind, Principled};
 use glam::Vec3;
 
+/// The shading normal a specular lobe uses in place of a normal- or bump-mapped `n` (unit,
+/// viewer's side), as Cycles' `ensure_valid_specular_reflection`: `n` itself when the mirror
+/// direction `r = 2 (n·wi) n - wi` of the unit direction `wi` towards the viewer stays at
+/// least `t = min(0.9 (wi·ng), 0.01)` above the geometric surface (`r·ng ≥ t`, `ng` unit on the
+/// viewer's side); else `n` turned towards `ng` in their common plane just enough that
+/// `r·ng = t` (the root of `4a z⁴ - 2b z² + c = 0` for `z = n'·ng`, with `a = x² + wz²`,
+/// `b = 2 (a + wz t)`, `c = (wz + t)²`, `x`, `wz` the components of `wi` along the tangent of
+/// that plane and along `ng`).
+pub fn valid_specular_normal(ng: Vec3, wi: Vec3, n: Vec3) -> Vec3 {
+    let r = 2.0 * n.dot(wi) * n - wi;
+    let wz = wi.dot(ng);
+    let t = (0.9 * wz).min(0.01);
+    if r.dot(ng) >= t {
+        return n;
+    }
+    let x = (n - n.dot(ng) * ng).try_normalize().unwrap_or(n);
+    let wx = wi.dot(x);
+    let a = wx * wx + wz * wz;
+    if a <= 0.0 {
+        return n;
+    }
+    let b = 2.0 * (a + wz * t);
+    let c = (t + wz) * (t + wz);
+    let disc = (b * b - 4.0 * a * c).max(0.0).sqrt();
+    // The root for which the unsquared equation holds (its two sides share wx's sign).
+    let z2 = if wx < 0.0 { b + disc } else { b - disc } * 0.25 / a;
+    let (nx, nz) = ((1.0 - z2).max(0.0).sqrt(), z2.max(0.0).sqrt());
+    (nx * x + nz * ng).normalize()
+}
+
 /// The BSDF of closure `c` (its weight is applied by the caller); `u` in `[0, 1)` chooses
 /// between the lobes of a layered closure such as the Principled BSDF. Anisotropic lobes
 /// take local +X as their tangent: the caller builds the frame from [`Closure::tangent`].
@@ -159,5 +189,56 @@ fn unlayered(b: BaseLobe) -> BsdfInstance {
             TopLobe::Sheen(Sheen::new(Vec3::ZERO, 0.5)),
             other,
         )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::valid_specular_normal;
+    use crate::sampler::Sampler;
+    use crate::sampling::square_to_uniform_sphere;
+
+    /// Over random geometric normals, view directions above the surface and shading normals on
+    /// the viewer's side: the result is a unit vector in the plane of `n` and `ng`, the mirror
+    /// direction stays above the threshold, valid normals are kept, and corrected ones lift
+    /// the mirror direction exactly to the threshold (the least turn).
+    #[test]
+    fn specular_normals_reflect_above_the_surface_with_the_least_turn() {
+        let mut rng = Sampler::new(11, 0, 0);
+        let (mut kept, mut turned) = (0, 0);
+        for _ in 0..20_000 {
+            let ng = square_to_uniform_sphere(rng.next_2d());
+            let mut wi = square_to_uniform_sphere(rng.next_2d());
+            if wi.dot(ng) < 0.0 {
+                wi = -wi;
+            }
+            let mut n = square_to_uniform_sphere(rng.next_2d());
+            if n.dot(ng) < 0.05 {
+                n = (n + ng * (0.05 - n.dot(ng) + 0.2)).normalize();
+            }
+            let wz = wi.dot(ng);
+            if wz < 1e-3 {
+                continue;
+            }
+            let t = (0.9 * wz).min(0.01);
+            let v = valid_specular_normal(ng, wi, n);
+            assert!((v.length() - 1.0).abs() < 1e-4, "{v}");
+            let rz = (2.0 * v.dot(wi) * v - wi).dot(ng);
+            let before = (2.0 * n.dot(wi) * n - wi).dot(ng);
+            if before >= t {
+                assert_eq!(v, n);
+                kept += 1;
+            } else {
+                assert!(
+                    (rz - t).abs() < 2e-3,
+                    "r.ng {rz} vs {t} (n {n}, wi {wi}, ng {ng})"
+                );
+                // In the plane of n and ng, turned towards ng.
+                assert!(v.dot(n.cross(ng)).abs() < 1e-3, "{v} {n} {ng}");
+                assert!(v.dot(ng) > n.dot(ng) - 1e-5);
+                turned += 1;
+            }
+        }
+        assert!(kept > 1000 && turned > 1000, "{kept} kept, {turned} turned");
     }
 }

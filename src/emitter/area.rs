@@ -30,6 +30,8 @@ pub struct AreaEmitter {
     /// The material's shading program, which gives the radiance at each point.
     pub program: Arc<Program>,
     pub two_sided: bool,
+    /// Camera to world, Blender coordinates, for the program's camera-space inputs.
+    pub camera_to_world: Mat4,
 }
 
 /// Geometric (unnormalised) normal of triangle `i` by the right-hand rule: its length is twice
@@ -74,14 +76,19 @@ impl AreaEmitter {
         } else {
             m.indices.len()
         };
+        let env = ShadeEnv {
+            images: &scene.images,
+            textures: &scene.textures,
+            camera_to_world: Mat4::IDENTITY,
+        };
         for i in (0..varying).step_by(step) {
             let third = 1.0 / 3.0;
-            let le = radiance(scene, &program, m, i as u32, Vec2::splat(third));
+            let le = radiance(&program, m, i as u32, Vec2::splat(third), None, &env);
             sum += le * areas[i];
             weight += areas[i];
         }
         let radiance = if program.is_empty() {
-            radiance(scene, &program, m, 0, Vec2::ZERO)
+            radiance(&program, m, 0, Vec2::ZERO, None, &env)
         } else if weight > 0.0 {
             sum / weight
         } else {
@@ -94,19 +101,28 @@ impl AreaEmitter {
             radiance,
             program,
             two_sided: material.emission_two_sided,
+            camera_to_world: Mat4::IDENTITY,
         })
     }
 
-    /// Radiance at the point of `rec` (before the sidedness test).
+    /// The emitter with the camera its program's camera-space inputs refer to.
+    pub fn with_camera(self, camera_to_world: Mat4) -> AreaEmitter {
+        AreaEmitter {
+            camera_to_world,
+            ..self
+        }
+    }
+
+    /// Radiance at the point of `rec` towards `rec.ref_p` (before the sidedness test).
     #[inline]
     fn radiance_at(&self, scene: &Scene, rec: &EmitterQueryRecord) -> Vec3 {
-        radiance(
-            scene,
-            &self.program,
-            &scene.meshes[self.mesh],
-            rec.tri,
-            rec.bary,
-        )
+        let env = ShadeEnv {
+            images: &scene.images,
+            textures: &scene.textures,
+            camera_to_world: self.camera_to_world,
+        };
+        let m = &scene.meshes[self.mesh];
+        radiance(&self.program, m, rec.tri, rec.bary, Some(rec), &env)
     }
 
     /// Chooses a triangle with probability proportional to its area, and the two numbers that
@@ -162,32 +178,61 @@ impl AreaEmitter {
     }
 }
 
-/// The emission of `program` at barycentrics `b` of triangle `tri` of `mesh`.
+/// The emission of `program` at barycentrics `b` of triangle `tri` of `mesh`, seen along
+/// `rec.wi` from `rec.ref_p` (`rec.n`, `rec.ng`: the shading and geometric normals there, on
+/// one side). The shading point is the one a ray from `rec.ref_p` hitting the point would
+/// have ([`crate::render_scene::RenderScene::globals`]): incoming direction `-rec.wi`,
+/// normals flipped towards it, backfacing when `rec.ng · rec.wi > 0`, ray length `rec.dist`;
+/// so a light sample and a BSDF ray reaching the same point from the same side see the same
+/// radiance. Without `rec` (the mean radiance for the light choice) the point is seen along
+/// its normal.
 #[inline]
-fn radiance(scene: &Scene, program: &Program, mesh: &Mesh, tri: u32, b: Vec2) -> Vec3 {
+fn radiance(
+    program: &Program,
+    mesh: &Mesh,
+    tri: u32,
+    b: Vec2,
+    rec: Option<&EmitterQueryRecord>,
+    env: &ShadeEnv,
+) -> Vec3 {
     if program.is_empty() {
         return program.emission(&ShaderGlobals::at(Vec3::ZERO, Vec3::Z, Vec2::ZERO), &ENV0);
     }
     let p = mesh
         .interpolate(&mesh.positions, tri, b.x, b.y)
         .unwrap_or(Vec3::ZERO);
-    let ng = triangle_cross(mesh, tri as usize).normalize_or_zero();
-    let n = mesh.shading_normal(tri, b.x, b.y).unwrap_or(ng);
     let uv = mesh
         .interpolate(&mesh.uvs, tri, b.x, b.y)
         .unwrap_or(Vec2::ZERO);
-    let mut g = ShaderGlobals::at(p, n, uv);
-    g.ng = to_blender(ng);
+    let mut g = match rec {
+        Some(rec) => {
+            let backfacing = rec.ng.dot(rec.wi) > 0.0;
+            let (n, ng) = if backfacing {
+                (-rec.n, -rec.ng)
+            } else {
+                (rec.n, rec.ng)
+            };
+            let mut g = ShaderGlobals::at(p, n, uv);
+            g.ng = to_blender(ng);
+            g.i = to_blender(-rec.wi);
+            g.backfacing = backfacing;
+            g.ray_length = rec.dist;
+            g.bump_step = rec.dist.max(1e-3) * 1e-4;
+            g
+        }
+        None => {
+            let ng = triangle_cross(mesh, tri as usize).normalize_or_zero();
+            let n = mesh.shading_normal(tri, b.x, b.y).unwrap_or(ng);
+            let mut g = ShaderGlobals::at(p, n, uv);
+            g.ng = to_blender(if ng.dot(n) < 0.0 { -ng } else { ng });
+            g
+        }
+    };
     g.mesh = Some(mesh);
     g.tri = tri;
     g.b1 = b.x;
     g.b2 = b.y;
-    let env = ShadeEnv {
-        images: &scene.images,
-        textures: &scene.textures,
-        camera_to_world: Mat4::IDENTITY,
-    };
-    program.emission(&g, &env)
+    program.emission(&g, env)
 }
 
 const ENV0: ShadeEnv<'static> = ShadeEnv {

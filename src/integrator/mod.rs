@@ -95,6 +95,21 @@ impl ShadingPoint {
         } else if n.dot(-d) < 0.0 {
             n = -n;
         }
+        if closure.normal != Vec3::ZERO
+            && matches!(
+                bsdf,
+                BsdfInstance::Mirror(_) | BsdfInstance::RoughConductor(_)
+            )
+        {
+            // Specular reflection lobes (Glossy, metallic Principled) under a normal or bump
+            // map reflect above the geometric surface, as Cycles makes them.
+            let ng = if its.ng.dot(-d) < 0.0 {
+                -its.ng
+            } else {
+                its.ng
+            };
+            n = bsdf::closure::valid_specular_normal(ng, -d, n);
+        }
         let frame = match anisotropic_rotation(&closure.kind) {
             Some(rotation) => {
                 let t = if closure.tangent == Vec3::ZERO {
@@ -398,9 +413,12 @@ pub fn trace_lit(
     let lights = if last && depth > 1 {
         scene.lights_on_ray(ctx, o, d, f32::INFINITY, depth, bsdf_pdf, true)
     } else {
-        let tmax = hit
-            .as_ref()
-            .map_or(f32::INFINITY, |its| (its.p - o).length());
+        let end = if depth == 1 {
+            ctx.camera_tmax(o, d)
+        } else {
+            f32::INFINITY
+        };
+        let tmax = hit.as_ref().map_or(end, |its| (its.p - o).length());
         scene.lights_on_ray(ctx, o, d, tmax, depth, bsdf_pdf, false)
     };
     (hit, emitted, lights)

@@ -652,7 +652,7 @@ pub struct Camera {
     /// Clip distances in metres along the view axis, as Cycles applies them: a camera ray
     /// starts where the pinhole ray of its pixel crosses the plane `z = -clip_start` (at
     /// `clip_start` along the ray for panoramic cameras) and ends at `clip_end` the same way.
-    /// 0 and infinity for glTF cameras (their `znear`/`zfar` are not applied).
+    /// A glTF camera's `znear`/`zfar` (0 and infinity without them).
     pub clip_start: f32,
     pub clip_end: f32,
     /// Depth of field; `None` = a pinhole.

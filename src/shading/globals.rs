@@ -64,6 +64,8 @@ pub struct ShaderGlobals<'a> {
     pub bump_step: f32,
     /// Path vertex index of the point (1 = seen from the camera).
     pub ray_depth: u32,
+    /// Distance from the ray's origin to the point (Light Path's Ray Length; 0 without a ray).
+    pub ray_length: f32,
     pub ray_flags: u32,
 }
 
@@ -84,6 +86,7 @@ impl<'a> ShaderGlobals<'a> {
             uv0,
             bump_step: 1e-4,
             ray_depth: 1,
+            ray_length: 0.0,
             ray_flags: ray::CAMERA,
         }
     }

@@ -76,15 +76,21 @@ def _set_if(obj, attr, value):
 
 def clear_scene():
     """Remove every object of the current scene and every unused mesh, material, light and
-    camera, reset the world to black, and return the (current) scene."""
+    camera, give the scene a new black world, and return the (current) scene.
+
+    The world is replaced rather than edited: a test that changed its settings (sampling
+    method, ray visibility, ...) must not change the renders of the tests after it."""
     scene = bpy.context.scene
     for ob in list(scene.objects):
         bpy.data.objects.remove(ob, do_unlink=True)
+    old_world, scene.world = scene.world, None
+    if old_world is not None and old_world.users == 0:
+        bpy.data.worlds.remove(old_world)
     for coll in (bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras):
         for block in list(coll):
             if block.users == 0:
                 coll.remove(block)
-    world = scene.world or bpy.data.worlds.new("World")
+    world = bpy.data.worlds.new("World")
     scene.world = world
     bg = next((n for n in _use_nodes(world).nodes if n.type == "BACKGROUND"), None)
     if bg is not None:

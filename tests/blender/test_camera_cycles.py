@@ -1,6 +1,6 @@
 """Blender cameras through the add-on (TESELA_camera) against Cycles on the same scene: depth of
 field with a polygonal, rotated, anamorphic bokeh and a focus object, lens shift on a wide image,
-an orthographic camera with vertical sensor fit and shift, clip start, and panoramic cameras
+an orthographic camera with vertical sensor fit and shift, clip start and end, and panoramic cameras
 (fisheye equisolid, equidistant and a partial equirectangular).
 
 Criteria (imgcompare.compare): each RGB channel's mean within 2%, 8x8 block means within 5% at
@@ -116,6 +116,15 @@ def clip_start():
     return info
 
 
+def clip_end():
+    """The far clip plane (5.8 m, the scene's centre is 5.7 m away) cuts away the back of the
+    floor and half the box: the world shows behind them; with a near clip too."""
+    info = lit_scene(world=0.5)
+    camera().clip_start = 1.0
+    camera().clip_end = 5.8
+    return info
+
+
 def _pano(kind, **settings):
     info = lit_scene(world=0.6)
     ob = bpy.context.scene.camera
@@ -136,6 +145,7 @@ CASES = [
     ("lens_shift", lens_shift, 256),
     ("ortho_vertical_shift", ortho_vertical_shift, 256),
     ("clip_start", clip_start, 256),
+    ("clip_end", clip_end, 256),
     ("fisheye_equisolid", lambda: _pano("FISHEYE_EQUISOLID", fisheye_lens=8.0,
                                         fisheye_fov=math.radians(180.0)), 256),
     ("fisheye_equidistant", lambda: _pano("FISHEYE_EQUIDISTANT",

@@ -28,8 +28,8 @@ What depends on the viewing ray or the camera (Incoming, Reflection, Camera coor
 Backfacing, Layer Weight, Fresnel, normals of back faces, Bump, Normal Map) is seen instead
 through a Diffuse BSDF (roughness 0) under a constant white world that is not sampled as a
 light: one cosine-sampled bounce (Cycles: max bounces 0; Tesela: path_mats, depth 2) returns
-exactly the albedo, without noise, on the plane and on the convex facet dome. (Through Emission
-these fail: Tesela shades emission with a stand-in shading point; see ``EMITTER_GLOBALS``.)
+exactly the albedo, without noise, on the plane and on the convex facet dome. A few are also
+seen through Emission, whose shading point must be the hit's own.
 
 Criteria: continuous outputs: max |Tesela - Cycles| / max(1, |Cycles|) over RGB below ``tol``
 (default 1e-3); discontinuous outputs (cells, steps, comparisons): fraction of pixels off by
@@ -875,19 +875,13 @@ def transformed_facets(mat):
     return facets(mat, ((0.3, -0.2, 0.5), (1.5, 0.6, 1.2)))
 
 
-EMITTER_GLOBALS = (
-    "the emission of a hit is shaded with ShaderGlobals::at(p, n, uv) (src/emitter/area.rs, "
-    "radiance()): incoming = normal, never backfacing, normal not flipped to the viewer, "
-    "camera = identity; it should be shaded with the hit's own globals "
-    "(RenderScene::globals(its, d, depth, flags) and shade_env())")
-
 # Linear fields, averaged over the pixel (64 spp).
 for output, geom, offset in (("Generated", transformed_plane, 3.0),
                              ("Object", transformed_plane, 4.0), ("UV", transformed_plane, 0.0)):
     case("tex_coord-%s" % output.lower(), coord(output), geometry=geom, offset=offset,
          snapped=False)
 # What depends on the camera or the viewing direction: seen through a Diffuse BSDF under a
-# white world (the BSDF's shading point is the hit's own), and once through Emission (xfail).
+# white world (the BSDF's shading point is the hit's own), and once through Emission.
 for output, geom, scale in (("Camera", plane, 0.08), ("Camera", persp_plane, 0.12),
                             ("Reflection", persp_plane, 0.5)):
     case("tex_coord-%s-%s" % (output.lower(), geom.__name__), coord(output), geometry=geom,
@@ -947,17 +941,14 @@ case("fresnel-ior-field",
 case("fresnel-ior-1.45", lambda g: g.out(g.new("ShaderNodeFresnel", IOR=1.45)), geometry=facets,
      mode="diffuse")
 
-# The same through Emission: the emitter's shading point lacks them (see EMITTER_GLOBALS).
-case("emission-tex_coord-camera", coord("Camera"), offset=6.0, snapped=False,
-     xfail=EMITTER_GLOBALS)
+# The same through Emission: the emitter is shaded at the hit's own shading point.
+case("emission-tex_coord-camera", coord("Camera"), offset=6.0, snapped=False)
 case("emission-geometry-incoming", coord("Incoming", GEO), geometry=persp_plane, offset=1.0,
-     snapped=False, xfail=EMITTER_GLOBALS)
-case("emission-geometry-backfacing", coord("Backfacing", GEO), geometry=facets,
-     xfail=EMITTER_GLOBALS)
+     snapped=False)
+case("emission-geometry-backfacing", coord("Backfacing", GEO), geometry=facets)
 case("emission-layer_weight-facing", lambda g: g.out(g.new("ShaderNodeLayerWeight"), "Facing"),
-     geometry=facets, xfail=EMITTER_GLOBALS)
-case("emission-geometry-normal-backfaces", coord("Normal", GEO), geometry=facets, offset=1.0,
-     xfail=EMITTER_GLOBALS)
+     geometry=facets)
+case("emission-geometry-normal-backfaces", coord("Normal", GEO), geometry=facets, offset=1.0)
 
 
 # -- Image Texture -----------------------------------------------------------------------------
@@ -1054,9 +1045,7 @@ for output in ("Is Camera Ray", "Is Shadow Ray", "Is Diffuse Ray", "Is Glossy Ra
         case("light_path-%s-%s" % (output.lower().replace(" ", "_"), mode),
              light_path_case(output, 0.5), mode=mode, offset=0.25 if mode == "diffuse" else 0.0,
              scale=0.5 if mode == "diffuse" else 1.0)
-case("light_path-ray_length", light_path_case("Ray Length", 0.1),
-     xfail="Light Path > Ray Length is a constant 0 (src/shading/nodes/input.rs): the shading "
-           "point does not carry the ray's length (ShaderGlobals, src/shading/globals.rs)")
+case("light_path-ray_length", light_path_case("Ray Length", 0.1))
 
 
 def raw_height(g, cx, cy, c0):

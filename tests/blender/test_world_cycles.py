@@ -209,16 +209,6 @@ def _case_id(c):
     return (c.values[0] if hasattr(c, "values") else c)[0]
 
 
-# Order-dependent: run alone, every case agrees (7/7 within 2% / 5%); run after the rest of
-# tests/blender in one process, the HDRI cases come out 0.7-2.7% off with 8x8-block p95 ~0.12,
-# so some state left behind by an earlier test changes one of the two renders. Kept visible
-# (non-strict) until that state is found.
-WORLD_REGRESSION = pytest.mark.xfail(
-    strict=False,
-    reason="order-dependent: agrees alone, 0.7-2.7% off after the other test files (leaked state)")
-
-
-@WORLD_REGRESSION
 @pytest.mark.parametrize("case", CASES, ids=[_case_id(c) for c in CASES])
 def test_world_agrees_with_cycles(addon, tesela_bin, tmp_path, monkeypatch, case):
     name, transparent = case[0], case[4]
@@ -240,7 +230,6 @@ def test_world_agrees_with_cycles(addon, tesela_bin, tmp_path, monkeypatch, case
         assert np.all(got[..., 3] == 1.0), "an opaque film has alpha 1 everywhere"
 
 
-@WORLD_REGRESSION
 def test_world_hidden_from_camera_lights_but_shows_black(addon, tesela_bin, tmp_path,
                                                          monkeypatch):
     """world.cycles_visibility.camera off: the backdrop is black (alpha 1), the lighting stays."""

@@ -136,11 +136,27 @@ impl<'a> Loader<'a> {
                 "node {ni}: camera transform is degenerate (zero scale)"
             ))
         })?;
-        // glTF's znear/zfar are depth-buffer ranges for rasterizers: not applied.
+        // znear/zfar clip as Blender's importer makes them clip_start/clip_end: the rays
+        // start at the plane znear in front of the camera and end at the plane zfar.
+        let (znear, zfar) = match (&projection, &cam.perspective, &cam.orthographic) {
+            (Projection::Perspective { .. }, Some(p), _) => (p.znear, p.zfar),
+            (Projection::Orthographic { .. }, _, Some(o)) => (o.znear, Some(o.zfar)),
+            _ => (0.0, None),
+        };
+        let clip_start = if znear.is_finite() && znear > 0.0 {
+            znear
+        } else {
+            0.0
+        };
+        let clip_end = zfar
+            .filter(|z| z.is_finite() && *z > clip_start)
+            .unwrap_or(f32::INFINITY);
         let gltf = Camera {
             projection,
             to_world,
             aspect,
+            clip_start,
+            clip_end,
             ..Default::default()
         };
         let Some(ext) = extension(self.raw_item("nodes", ni), "TESELA_camera") else {

@@ -34,6 +34,7 @@ pub enum Source {
     /// Light Path flag bit.
     RayFlag(u32),
     RayDepth,
+    RayLength,
     /// Colour attribute by name: `(name, alpha?)`.
     Color(String, bool),
     /// A geometry attribute by name: a UV map (Blender convention) or a colour attribute.
@@ -147,6 +148,7 @@ impl InputOp {
             Source::ObjectRandom => s.set_f(self.out, info.map_or(0.0, |o| o.random)),
             Source::RayFlag(bit) => s.set_f(self.out, flag(g.ray_flags & bit != 0)),
             Source::RayDepth => s.set_f(self.out, g.ray_depth.saturating_sub(1) as f32),
+            Source::RayLength => s.set_f(self.out, g.ray_length),
             Source::Color(name, alpha) => {
                 let c = g.color_attribute(name).unwrap_or(glam::Vec4::ZERO);
                 if *alpha {
@@ -275,10 +277,10 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
                 emit(cx, id, Float, Source::RayFlag(bit))?;
             }
             emit(cx, "Ray Depth", Float, Source::RayDepth)?;
+            emit(cx, "Ray Length", Float, Source::RayLength)?;
             let zero = cx.constant(&[0.0])?;
             for id in [
                 "Is Volume Scatter Ray",
-                "Ray Length",
                 "Diffuse Depth",
                 "Glossy Depth",
                 "Transparent Depth",
