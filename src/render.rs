@@ -11,6 +11,18 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
 
+/// How a pixel's samples draw their random numbers.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Sampling {
+    /// One Owen-scrambled Sobol sequence per pixel ([`SobolSampler`]): the samples of a pixel
+    /// are stratified, and error falls faster than 1/N where the integrand is smooth.
+    #[default]
+    Sobol,
+    /// Every sample its own scramble (the first point of a sequence seeded by the sample):
+    /// independent uniform numbers, plain Monte Carlo whose variance falls as exactly 1/N.
+    Independent,
+}
+
 /// What to render.
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
@@ -153,6 +165,7 @@ fn render_pixel(
     py: u32,
     ctx: &mut Ctx,
     rejected: &mut u64,
+    sampling: Sampling,
 ) -> [f32; 4] {
     let pixel_index = py as u64 * opts.width as u64 + px as u64;
     let mut sum = Vec3::ZERO;
@@ -164,7 +177,12 @@ fn render_pixel(
     let transparent = scene.scene.settings.film_transparent;
     let lens = camera.has_lens();
     for s in 0..opts.spp {
-        ctx.sampler = SobolSampler::new(opts.seed, pixel_index, s as u64);
+        ctx.sampler = match sampling {
+            Sampling::Sobol => SobolSampler::new(opts.seed, pixel_index, s as u64),
+            Sampling::Independent => {
+                SobolSampler::new(independent_seed(opts.seed, s), pixel_index, 0)
+            }
+        };
         // Dimension 0: the pixel filter; 1: the lens, only for cameras with depth of field.
         let film = Vec2::new(px as f32, py as f32) + ctx.sampler.next_2d();
         let u_lens = if lens {
@@ -199,6 +217,16 @@ fn render_pixel(
         1.0
     };
     [c.x, c.y, c.z, alpha]
+}
+
+/// The seed of sample `s` under [`Sampling::Independent`] (a bijective mix, so no two samples
+/// of a render share a scramble).
+#[inline]
+fn independent_seed(seed: u64, s: u32) -> u64 {
+    let mut z = seed ^ ((s as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
 }
 
 /// What every render with `opts` starts from.
@@ -245,6 +273,7 @@ pub fn record_rays(
                 y,
                 &mut ctx,
                 &mut rejected,
+                Sampling::Sobol,
             );
         }
     }
@@ -256,6 +285,17 @@ pub fn record_rays(
 pub fn render(
     scene: &RenderScene,
     opts: &RenderOptions,
+    cancel: &AtomicBool,
+    on_tile: &(dyn Fn(&Tile, usize, usize) + Sync),
+) -> Result<(Image, RenderStats), RenderError> {
+    render_sampled(scene, opts, Sampling::Sobol, cancel, on_tile)
+}
+
+/// [`render`] with the random numbers drawn as `sampling` says.
+pub fn render_sampled(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    sampling: Sampling,
     cancel: &AtomicBool,
     on_tile: &(dyn Fn(&Tile, usize, usize) + Sync),
 ) -> Result<(Image, RenderStats), RenderError> {
@@ -302,6 +342,7 @@ pub fn render(
                             ry + ty + y,
                             &mut ctx,
                             &mut rej,
+                            sampling,
                         ));
                     }
                 }
