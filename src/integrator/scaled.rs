@@ -10,10 +10,11 @@ use glam::Vec3;
 #[doc(hidden)]
 pub const BIASED_NAME: &str = "test_biased_direct_mis";
 
-/// How much too bright [`BIASED_NAME`] is: 2 %, a bias well inside the noise of a single
-/// low-spp image but many standard errors of a study's pooled mean.
+/// How much too bright [`BIASED_NAME`] is: 5 %, inside the noise of a single low-spp image
+/// (a 32 × 32 Cornell box at 16 spp has a relative RMS error of tens of percent) but several
+/// standard errors of a study's pooled mean.
 #[doc(hidden)]
-pub const BIASED_FACTOR: f32 = 1.02;
+pub const BIASED_FACTOR: f32 = 1.05;
 
 #[doc(hidden)]
 pub struct Scaled {
