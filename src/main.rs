@@ -149,13 +149,13 @@ struct StudyArgs {
     #[arg(long, value_delimiter = ',')]
     integrators: Option<Vec<String>>,
     /// Image width in pixels (the height follows the camera's aspect ratio).
-    #[arg(long, default_value_t = 96)]
+    #[arg(long, default_value_t = 64)]
     width: u32,
     /// Samples per pixel of each of the reference's renders.
     #[arg(long, default_value_t = 1024)]
     reference_spp: u32,
     /// Independent renders averaged into each reference (at least 2).
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 4)]
     reference_seeds: u32,
     /// Samples per pixel of the light-size sweep's renders.
     #[arg(long, default_value_t = 16)]

@@ -126,8 +126,8 @@ pub fn spp_ladder(max: u32) -> Vec<u32> {
 }
 
 impl StudyConfig {
-    /// The default study: the seed's figure scenes at 96 pixels wide, spp 1…`spp_max`,
-    /// `seeds` seeds, references of 8 × 1024 spp, the light-size sweep from 1/16 to 4 times
+    /// The default study: the seed's figure scenes at 64 pixels wide, spp 1…`spp_max`,
+    /// `seeds` seeds, references of 4 × 1024 spp, the light-size sweep from 1/16 to 4 times
     /// the area at 16 spp, strips at 16 spp, independent samples.
     pub fn default_with(spp_max: u32, seeds: u32) -> StudyConfig {
         StudyConfig {
@@ -135,11 +135,11 @@ impl StudyConfig {
                 .iter()
                 .filter_map(|n| StudyScene::builtin(n))
                 .collect(),
-            width: 96,
+            width: 64,
             spp: spp_ladder(spp_max),
             seeds,
             reference_spp: 1024,
-            reference_seeds: 8,
+            reference_seeds: 4,
             max_depth: 16,
             threads: 0,
             sweep: Some(Sweep {
