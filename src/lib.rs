@@ -20,4 +20,5 @@ pub mod sampler;
 pub mod sampling;
 pub mod scene;
 pub mod shading;
+pub mod study;
 pub mod texture;

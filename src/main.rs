@@ -46,6 +46,9 @@ enum Command {
         /// A .gltf or .glb file.
         scene: PathBuf,
     },
+    /// Measure the integrators: relMSE, bias and time against converged references, a
+    /// light-size sweep, plots and a report (docs/study.md shows a run).
+    Study(StudyArgs),
     /// Write a built-in scene as a .gltf file (how scenes/*.gltf are made).
     ExportBuiltin {
         /// One of: cornell-box, cornell-spheres, glass-pane.
@@ -66,7 +69,9 @@ struct RenderArgs {
     /// Default: tesela.png (no file in --pipe mode unless given).
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Integrator: direct_ems, direct_mats, direct_mis, path_mats, path_mis, normals, albedo.
+    /// Integrator: direct_ems, direct_mats, direct_mis, path_mats, path_mis, normals, albedo,
+    /// or direct_ems_first_hit (emitter sampling at the first hit only: mirrors and glass show
+    /// black, as in the assignment's own direct_ems; direct_ems follows their delta chains).
     /// Default: the scene's TESELA_render setting, else path_mis.
     #[arg(long)]
     integrator: Option<String>,
@@ -163,6 +168,154 @@ struct RenderArgs {
     /// A constant world of linear RGB radiance R G B, replacing the scene's world.
     #[arg(long, num_args = 3, value_names = ["R", "G", "B"])]
     background: Option<Vec<f32>>,
+}
+
+#[derive(clap::Args)]
+struct StudyArgs {
+    /// Scenes: built-in names (cornell-box, cornell-spheres, glass-pane) or .gltf/.glb files.
+    /// Default: the three built-in figure scenes.
+    scenes: Vec<String>,
+    /// Folder for study.json, study.md and the figures (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+    /// The spp ladder is 1, 2, 4, ... up to N.
+    #[arg(long, default_value_t = 64)]
+    spp_max: u32,
+    /// Independent seeds per rung of the ladder.
+    #[arg(long, default_value_t = 4)]
+    seeds: u32,
+    /// Comma-separated integrators measured on every scene. Default: direct_ems,
+    /// direct_mats, direct_mis, and where a scene has mirrors or glass also
+    /// direct_ems_first_hit, path_mats, path_mis.
+    #[arg(long, value_delimiter = ',')]
+    integrators: Option<Vec<String>>,
+    /// Image width in pixels (the height follows the camera's aspect ratio).
+    #[arg(long, default_value_t = 64)]
+    width: u32,
+    /// Samples per pixel of each of the reference's renders.
+    #[arg(long, default_value_t = 1024)]
+    reference_spp: u32,
+    /// Independent renders averaged into each reference (at least 2).
+    #[arg(long, default_value_t = 4)]
+    reference_seeds: u32,
+    /// Samples per pixel of the light-size sweep's renders.
+    #[arg(long, default_value_t = 16)]
+    sweep_spp: u32,
+    /// Skip the light-size sweep.
+    #[arg(long)]
+    no_sweep: bool,
+    /// The rung of the ladder shown in the image strips.
+    #[arg(long, default_value_t = 16)]
+    strip_spp: u32,
+    /// Random numbers: independent (plain Monte Carlo, whose error falls as 1/N; the
+    /// assignment's) or sobol (Tesela's stratified samples, as `tesela render` uses).
+    #[arg(long, default_value = "independent", value_parser = ["independent", "sobol"])]
+    sampler: String,
+    /// Worker threads per render (0 = one per core).
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// No progress bar.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+fn run_study(args: &StudyArgs) -> ExitCode {
+    use tesela::study::{self, StudyConfig, StudyScene};
+    let mut config = StudyConfig::default_with(args.spp_max, args.seeds);
+    if !args.scenes.is_empty() {
+        let mut scenes = Vec::new();
+        for s in &args.scenes {
+            let found = match StudyScene::builtin(s) {
+                Some(b) => Ok(b),
+                None => scene::gltf::load(Path::new(s))
+                    .map(|sc| {
+                        let name = Path::new(s)
+                            .file_stem()
+                            .map_or(s.clone(), |n| n.to_string_lossy().into_owned());
+                        StudyScene::new(&name, sc)
+                    })
+                    .map_err(|e| e.to_string()),
+            };
+            match found {
+                Ok(sc) => scenes.push(sc),
+                Err(e) => {
+                    eprintln!("tesela: error: {e}");
+                    return ExitCode::from(EXIT_LOAD);
+                }
+            }
+        }
+        config.scenes = scenes;
+    }
+    if let Some(list) = &args.integrators {
+        for s in &mut config.scenes {
+            s.integrators = list.clone();
+        }
+    }
+    config.width = args.width;
+    config.reference_spp = args.reference_spp;
+    config.reference_seeds = args.reference_seeds;
+    config.threads = args.threads;
+    config.strip_spp = args.strip_spp;
+    if args.sampler == "sobol" {
+        config.sampling = render::Sampling::Sobol;
+    }
+    if args.no_sweep {
+        config.sweep = None;
+    } else if let Some(sw) = &mut config.sweep {
+        sw.spp = args.sweep_spp;
+    }
+    if config.width == 0 || config.width > 4096 {
+        eprintln!(
+            "tesela: error: --width {} must be in 1..=4096",
+            config.width
+        );
+        return ExitCode::from(EXIT_USAGE);
+    }
+    let bar = if args.quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        let b = indicatif::ProgressBar::new(1);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {bar:40} {percent}% {msg} ({eta})",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b
+    };
+    let outcome = match study::run(&config, &bar, &CANCEL) {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("tesela: error: {e}");
+            return ExitCode::from(EXIT_RENDER);
+        }
+    };
+    match study::write(&args.out, &outcome) {
+        Ok(files) => {
+            if !args.quiet {
+                eprintln!(
+                    "tesela: study of {} renders in {:.1} s -> {} ({} files)",
+                    outcome.study.measurements.len(),
+                    outcome.study.settings.seconds,
+                    args.out.display(),
+                    files.len()
+                );
+                for c in &outcome.study.claims {
+                    let v = match c.holds {
+                        Some(true) => "supported",
+                        Some(false) => "CONTRADICTED",
+                        None => "not measured",
+                    };
+                    eprintln!("  {v}: {}", c.id);
+                }
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("tesela: error: {e}");
+            ExitCode::from(EXIT_RENDER)
+        }
+    }
 }
 
 extern "C" fn on_signal(_: libc::c_int) {
@@ -780,6 +933,7 @@ fn main() -> ExitCode {
             }
         }
         Command::Info { scene } => run_info(&scene),
+        Command::Study(args) => run_study(&args),
         Command::ExportBuiltin { name, out } => match scene::builtin::by_name(&name) {
             Some(s) => match scene::gltf_write::write(&s, &out) {
                 Ok(()) => ExitCode::SUCCESS,

@@ -13,6 +13,18 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
+/// How a pixel's samples draw their random numbers.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Sampling {
+    /// One Owen-scrambled Sobol sequence per pixel ([`SobolSampler`]): the samples of a pixel
+    /// are stratified, and error falls faster than 1/N where the integrand is smooth.
+    #[default]
+    Sobol,
+    /// Every sample its own scramble (the first point of a sequence seeded by the sample):
+    /// independent uniform numbers, plain Monte Carlo whose variance falls as exactly 1/N.
+    Independent,
+}
+
 /// What to render.
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
@@ -300,13 +312,19 @@ fn render_samples(
     rejected: &mut u64,
     acc: &mut PixelAcc,
     aov: &mut [f32],
+    sampling: Sampling,
 ) {
     let pixel_index = py as u64 * opts.width as u64 + px as u64;
     let transparent = scene.scene.settings.film_transparent;
     let lens = camera.has_lens();
     let adaptive = opts.adaptive.is_some();
     for s in acc.next..end {
-        ctx.sampler = SobolSampler::new(opts.seed, pixel_index, s as u64);
+        ctx.sampler = match sampling {
+            Sampling::Sobol => SobolSampler::new(opts.seed, pixel_index, s as u64),
+            Sampling::Independent => {
+                SobolSampler::new(independent_seed(opts.seed, s), pixel_index, 0)
+            }
+        };
         // Dimension 0: the pixel filter; 1: the lens, only for cameras with depth of field.
         let u = ctx.sampler.next_2d();
         let film = Vec2::new(
@@ -341,6 +359,16 @@ fn render_samples(
         }
     }
     acc.next = acc.next.max(end);
+}
+
+/// The seed of sample `s` under [`Sampling::Independent`] (a bijective mix, so no two samples
+/// of a render share a scramble).
+#[inline]
+fn independent_seed(seed: u64, s: u32) -> u64 {
+    let mut z = seed ^ ((s as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
 }
 
 /// What every render with `opts` starts from.
@@ -391,6 +419,7 @@ pub fn record_rays(
                 &mut rejected,
                 &mut acc,
                 &mut [],
+                Sampling::Sobol,
             );
         }
     }
@@ -438,6 +467,17 @@ impl TileState {
 pub fn render(
     scene: &RenderScene,
     opts: &RenderOptions,
+    cancel: &AtomicBool,
+    on_tile: &(dyn Fn(&Tile, usize, usize) + Sync),
+) -> Result<(Image, RenderStats), RenderError> {
+    render_sampled(scene, opts, Sampling::Sobol, cancel, on_tile)
+}
+
+/// [`render`] with the random numbers drawn as `sampling` says.
+pub fn render_sampled(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    sampling: Sampling,
     cancel: &AtomicBool,
     on_tile: &(dyn Fn(&Tile, usize, usize) + Sync),
 ) -> Result<(Image, RenderStats), RenderError> {
@@ -517,6 +557,7 @@ pub fn render(
                             &mut rej,
                             acc,
                             &mut t.aov[i * stride..(i + 1) * stride],
+                            sampling,
                         );
                     }
                 }

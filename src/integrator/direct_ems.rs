@@ -1,6 +1,11 @@
 //! Direct illumination by emitter sampling (the seed's `direct_ems`): at the first non-delta
 //! surface, one light sample and a shadow ray. Emitters seen directly (or through a chain of
 //! delta bounces) show their radiance.
+//!
+//! With `follow_delta` off (the integrator `direct_ems_first_hit`) it is the assignment's own
+//! estimator: emitter sampling at the camera ray's first hit only. A delta BSDF there (mirror,
+//! glass) has no density to sample a light against, so the surface shows only its emission:
+//! a mirror's reflection of a light is black.
 
 use super::{Integrator, MAX_TRANSPARENT, ShadingPoint, sample_emitter, spawn, trace_lit};
 use crate::render_scene::{Ctx, RenderScene};
@@ -8,6 +13,9 @@ use glam::Vec3;
 
 pub struct DirectEms {
     pub max_depth: u32,
+    /// Follow chains of delta bounces to the first non-delta surface (Tesela's default);
+    /// `false` stops at the first hit.
+    pub follow_delta: bool,
 }
 
 impl Integrator for DirectEms {
@@ -47,6 +55,9 @@ impl Integrator for DirectEms {
             }
             if !sp.bsdf_is_delta() {
                 return l + throughput * sample_emitter(scene, ctx, &its, &sp, d, false);
+            }
+            if !self.follow_delta {
+                return l;
             }
             // Emitter sampling cannot see a delta BSDF: follow it.
             let Some((wo, w, _)) = sp.sample(ctx, &its, d) else {

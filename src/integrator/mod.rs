@@ -10,6 +10,7 @@ pub mod direct_ems;
 pub mod direct_mats;
 pub mod direct_mis;
 pub mod path;
+pub mod scaled;
 
 use crate::accel::offset_origin;
 use crate::bsdf::{self, Bsdf, BsdfInstance, BsdfQueryRecord};
@@ -22,9 +23,11 @@ pub trait Integrator: Send + Sync {
     fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3;
 }
 
-/// The integrators selectable by name.
-pub const NAMES: [&str; 7] = [
+/// The integrators selectable by name. `direct_ems_first_hit` is emitter sampling at the
+/// first hit only, without following delta chains (see [`direct_ems`]).
+pub const NAMES: [&str; 8] = [
     "direct_ems",
+    "direct_ems_first_hit",
     "direct_mats",
     "direct_mis",
     "path_mats",
@@ -36,7 +39,19 @@ pub const NAMES: [&str; 7] = [
 /// Builds the integrator called `name` with the given maximum path depth.
 pub fn by_name(name: &str, max_depth: u32) -> Option<Box<dyn Integrator>> {
     Some(match name {
-        "direct_ems" => Box::new(direct_ems::DirectEms { max_depth }),
+        "direct_ems" => Box::new(direct_ems::DirectEms {
+            max_depth,
+            follow_delta: true,
+        }),
+        "direct_ems_first_hit" => Box::new(direct_ems::DirectEms {
+            max_depth,
+            follow_delta: false,
+        }),
+        // Deliberately wrong (not listed in NAMES): for tests that must catch a bias.
+        scaled::BIASED_NAME => Box::new(scaled::Scaled {
+            inner: by_name("direct_mis", max_depth)?,
+            factor: scaled::BIASED_FACTOR,
+        }),
         "direct_mats" => Box::new(direct_mats::DirectMats { max_depth }),
         "direct_mis" => Box::new(direct_mis::DirectMis { max_depth }),
         "path_mats" => Box::new(path::PathMats { max_depth }),

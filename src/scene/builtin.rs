@@ -236,6 +236,29 @@ pub fn cornell_box() -> Scene {
     scene
 }
 
+/// The diffuse Cornell box with its light's area scaled by `area_scale` about the light's
+/// centre and its radiance by `1 / area_scale`: the same emitted power (radiance × area × π
+/// for a one-sided Lambertian emitter) through a smaller or larger emitter. `area_scale` must
+/// keep the light inside the ceiling (at most 17: the ceiling is 1 m wide, the light 0.24 m).
+pub fn cornell_box_light_area(area_scale: f32) -> Scene {
+    let mut scene = cornell_box();
+    let k = area_scale.sqrt();
+    for m in &mut scene.meshes {
+        if m.name == "light" {
+            let c = m.positions.iter().copied().sum::<Vec3>() / m.positions.len() as f32;
+            for p in &mut m.positions {
+                *p = c + (*p - c) * Vec3::new(k, 1.0, k);
+            }
+        }
+    }
+    for m in &mut scene.materials {
+        if m.name == "light" {
+            m.emission /= area_scale;
+        }
+    }
+    scene
+}
+
 /// The Cornell box with a mirror sphere and a glass sphere (the seed's delta-BSDF figure).
 pub fn cornell_spheres() -> Scene {
     let mut scene = Scene::default();
