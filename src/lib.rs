@@ -9,6 +9,7 @@ pub mod bsdf;
 pub mod camera;
 pub mod emitter;
 pub mod frame;
+pub mod instancing;
 pub mod integrator;
 pub mod output;
 pub mod protocol;
