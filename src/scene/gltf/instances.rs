@@ -24,15 +24,18 @@ pub(crate) struct MeshUse {
     pub world: Mat4,
     /// `EXT_mesh_gpu_instancing` local transforms (`T · R · S`), empty without the extension.
     pub gpu: Vec<Mat4>,
+    /// The add-on's `_TESELA_RANDOM` attribute: each instance's Object Info random (may be
+    /// empty: then a hash of node and instance index).
+    pub gpu_random: Vec<f32>,
 }
 
 impl<'a> Loader<'a> {
     /// The `EXT_mesh_gpu_instancing` transforms of node `ni` (empty without the extension).
     /// Instances whose attributes are not finite or whose rotation is zero come back as a
     /// non-finite matrix, for [`Loader::place_meshes`] to skip.
-    pub(crate) fn gpu_instances(&mut self, ni: usize) -> Result<Vec<Mat4>, LoadError> {
+    pub(crate) fn gpu_instances(&mut self, ni: usize) -> Result<(Vec<Mat4>, Vec<f32>), LoadError> {
         let Some(ext) = extension(self.raw_item("nodes", ni), "EXT_mesh_gpu_instancing") else {
-            return Ok(Vec::new());
+            return Ok((Vec::new(), Vec::new()));
         };
         let Some(attrs) = member(ext, "attributes").and_then(|a| a.as_object()) else {
             return Err(invalid(format!(
@@ -75,12 +78,13 @@ impl<'a> Loader<'a> {
         let t = read("TRANSLATION", Type::Vec3)?;
         let r = read("ROTATION", Type::Vec4)?;
         let s = read("SCALE", Type::Vec3)?;
+        let random = read("_TESELA_RANDOM", Type::Scalar)?.unwrap_or_default();
         let n = count.unwrap_or(0);
         let v3 = |d: &Option<Vec<f32>>, k: usize, def: Vec3| {
             d.as_ref()
                 .map_or(def, |d| Vec3::from_slice(&d[3 * k..3 * k + 3]))
         };
-        Ok((0..n)
+        let transforms = (0..n)
             .map(|k| {
                 let q = r
                     .as_ref()
@@ -95,7 +99,8 @@ impl<'a> Loader<'a> {
                     v3(&t, k, Vec3::ZERO),
                 )
             })
-            .collect())
+            .collect();
+        Ok((transforms, random))
     }
 
     /// Turns the meshes the node walk found into scene meshes: baked where a mesh is placed
@@ -154,7 +159,10 @@ impl<'a> Loader<'a> {
                 }
                 let mut object = self.object_info(u.node, extras, world);
                 if locals.len() > 1 {
-                    object.random = instance_random(u.node, k);
+                    object.random = match u.gpu_random.get(k) {
+                        Some(r) if r.is_finite() => *r,
+                        _ => instance_random(u.node, k),
+                    };
                 }
                 for mesh in range.clone() {
                     self.scene.instances.push(Instance {

@@ -523,12 +523,13 @@ impl<'a> Loader<'a> {
                         self.root.meshes.len()
                     )));
                 }
-                let gpu = self.gpu_instances(ni)?;
+                let (gpu, gpu_random) = self.gpu_instances(ni)?;
                 uses.push(instances::MeshUse {
                     node: ni,
                     mesh: mi,
                     world,
                     gpu,
+                    gpu_random,
                 });
             }
             self.node_lights(ni, world)?;
