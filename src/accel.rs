@@ -152,6 +152,16 @@ impl Accel {
         Accel { bvh, tris, keys }
     }
 
+    /// Number of triangles.
+    pub fn len(&self) -> usize {
+        self.tris.len()
+    }
+
+    /// Whether there is no triangle.
+    pub fn is_empty(&self) -> bool {
+        self.tris.is_empty()
+    }
+
     /// Closest hit of the ray `o + t d` with `t` in `(tmin, tmax)`.
     pub fn intersect(&self, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
         self.intersect_with(&mut Traversal::default(), o, d, tmin, tmax)

@@ -97,6 +97,13 @@ impl InstanceAccel {
         })
     }
 
+    /// Triangles over all instances (each instance counting its mesh's).
+    pub fn triangles(&self) -> u64 {
+        (self.placements.iter())
+            .map(|p| self.blas[p.blas as usize].len() as u64)
+            .sum()
+    }
+
     /// Number of instances.
     pub fn len(&self) -> usize {
         self.placements.len()

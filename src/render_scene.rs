@@ -938,8 +938,9 @@ impl RenderScene {
         &self.accel
     }
 
-    pub fn triangle_count(&self) -> usize {
-        self.triangles
+    /// Triangles rendered: world-space meshes once, placed meshes once per instance.
+    pub fn triangle_count(&self) -> u64 {
+        self.triangles as u64 + self.instances.as_ref().map_or(0, |i| i.triangles())
     }
 }
 
