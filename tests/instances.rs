@@ -155,3 +155,47 @@ fn an_emissive_instance_lights_as_its_area_under_scale() {
         );
     }
 }
+
+#[test]
+fn written_instances_load_back_as_instances() {
+    let scene = instanced();
+    let dir = std::env::temp_dir().join(format!("tesela-instances-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("instanced.gltf");
+    tesela::scene::gltf_write::write(&scene, &path).unwrap();
+    let back = tesela::scene::gltf::load(&path).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(back.instances.len(), scene.instances.len());
+    assert_eq!(
+        back.instanced_triangle_count(),
+        scene.instanced_triangle_count()
+    );
+    // The ball is stored once per material it is drawn with.
+    let balls = back.meshes.iter().filter(|m| m.name == "ball").count();
+    assert_eq!(balls, 3);
+    for a in &scene.instances {
+        assert!(
+            back.instances
+                .iter()
+                .any(|i| i.to_world.abs_diff_eq(a.to_world, 1e-6)),
+            "{:?} written and read back",
+            a.to_world
+        );
+    }
+    let names = |s: &Scene| {
+        let mut v: Vec<String> = (s.instances.iter())
+            .map(|i| {
+                s.materials[i.material.unwrap_or(s.meshes[i.mesh].material)]
+                    .name
+                    .clone()
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(
+        names(&back),
+        names(&scene),
+        "each instance keeps its material"
+    );
+}
