@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 import bpy
+import numpy as np
 import pytest
 
 import imgcompare
@@ -113,3 +114,33 @@ def test_scatter_agrees_with_cycles(addon, tesela_bin, tmp_path, monkeypatch):
     result = imgcompare.compare(got, ref, mean_tol=0.02, block_tol=0.05)
     print(f"scatter: {result}")
     assert result.ok, f"scatter: Tesela (add-on) vs Cycles: {result}"
+
+
+def test_collection_instances_share_one_mesh(addon, tmp_path):
+    """Three collection-instance empties of a collection holding one box, and the box itself:
+    one glTF mesh, placed by four nodes (below the GPU-instancing threshold)."""
+    scenes.light_over_plane("point", with_box=False)
+    coll = bpy.data.collections.new("Rocks")
+    bpy.context.scene.collection.children.link(coll)
+    box = scenes.add_box("Rock", (-0.1, -0.1, 0.0), (0.1, 0.1, 0.2), scenes.lambert("RockMat", (0.5, 0.5, 0.5)))
+    for c in box.users_collection:
+        c.objects.unlink(box)
+    coll.objects.link(box)
+    for k in range(3):
+        e = bpy.data.objects.new(f"Copy{k}", None)
+        e.instance_type = "COLLECTION"
+        e.instance_collection = coll
+        e.location = (0.5 * k - 0.5, 0.8, 0.0)
+        e.scale = (1.0, 1.0, -1.0) if k == 1 else (1.0, 1.0, 1.0)
+        bpy.context.scene.collection.objects.link(e)
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    path = tmp_path / "coll.gltf"
+    write_gltf(depsgraph, str(path), width=SIZE, height=SIZE)
+    doc = json.loads(path.read_text())
+    rocks = [i for i, m in enumerate(doc["meshes"]) if m["name"] == "Rock"]
+    assert len(rocks) == 1, [m["name"] for m in doc["meshes"]]
+    users = [nd for nd in doc["nodes"] if nd.get("mesh") == rocks[0]]
+    assert len(users) == 4
+    dets = sorted(round(float(np.linalg.det(np.array(nd["matrix"]).reshape(4, 4)[:3, :3])), 3)
+                  for nd in users)
+    assert dets == [-1.0, 1.0, 1.0, 1.0], dets
