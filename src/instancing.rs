@@ -40,7 +40,8 @@ pub struct InstanceAccel {
 
 impl InstanceAccel {
     /// The BVHs over `scene.instances` whose `keep(instance index)` holds, or `None` when no
-    /// instance is kept. Bottom-level hits carry the key `[mesh index, triangle index]`.
+    /// instance is kept. Instances that cannot be drawn (a missing mesh or material, a
+    /// singular or non-finite transform) are left out. Bottom-level hits carry the key `[mesh index, triangle index]`.
     pub fn new(scene: &Scene, keep: impl Fn(usize) -> bool) -> Option<InstanceAccel> {
         let mut blas_of = vec![u32::MAX; scene.meshes.len()];
         let mut blas = Vec::new();
@@ -50,7 +51,12 @@ impl InstanceAccel {
             let Some(mesh) = scene.meshes.get(inst.mesh) else {
                 continue;
             };
-            if !keep(ii) || mesh.indices.is_empty() || Instance::check(&inst.to_world).is_some() {
+            let bad_material = inst.material.is_some_and(|m| m >= scene.materials.len());
+            if !keep(ii)
+                || mesh.indices.is_empty()
+                || bad_material
+                || Instance::check(&inst.to_world).is_some()
+            {
                 continue;
             }
             let Some((lo, hi)) = mesh.bounds() else {

@@ -273,3 +273,31 @@ fn shading_reads_the_same_through_an_instance_as_baked() {
         assert_eq!(si, sb, "{with_tangents}: bitangent sign");
     }
 }
+
+#[test]
+fn instances_that_cannot_be_drawn_are_left_out_without_a_panic() {
+    let mut scene = instanced();
+    let good = render_scene(instanced(), "albedo");
+    let mut bad = scene.instances[0].clone();
+    for to_world in [
+        Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0)),
+        Mat4::from_translation(Vec3::NAN),
+    ] {
+        scene.instances.push(Instance {
+            to_world,
+            ..bad.clone()
+        });
+    }
+    // In plain view at the centre of the box.
+    bad.to_world = Mat4::from_scale_rotation_translation(
+        Vec3::splat(0.2),
+        Quat::IDENTITY,
+        Vec3::new(0.0, 0.5, 0.2),
+    );
+    bad.material = Some(999);
+    scene.instances.push(bad.clone());
+    bad.material = None;
+    bad.mesh = 999;
+    scene.instances.push(bad);
+    assert_eq!(render_scene(scene, "albedo"), good);
+}
