@@ -2,8 +2,12 @@
 //! Cornell box with a finely tessellated displaced sphere, as one `.glb`.
 //!
 //! ```sh
-//! cargo run --release --example big_scene -- OUT.glb [TRIANGLES]   # default 10,000,000
+//! cargo run --release --example big_scene -- OUT.glb [TRIANGLES] [INSTANCES]
 //! ```
+//!
+//! TRIANGLES defaults to 10,000,000. With INSTANCES > 1 the sphere (of TRIANGLES triangles)
+//! is placed INSTANCES times by `EXT_mesh_gpu_instancing` on a grid over the floor of the
+//! box, each with its own size (a scatter).
 //!
 //! The sphere is a UV grid of `2 n × n` quads (`4 n²` triangles, the first `n` large enough
 //! to reach TRIANGLES; the pole rows hold zero-area triangles, as real UV spheres do) with
@@ -22,6 +26,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(t) => t.parse()?,
         None => 10_000_000,
     };
+    let instances: usize = match args.next() {
+        Some(t) => t.parse()?,
+        None => 1,
+    };
     let n = ((want as f64 / 4.0).sqrt().ceil() as u32).max(2);
     let (nu, nv) = (2 * n, n);
     let verts = (nu + 1) as usize * (nv + 1) as usize;
@@ -38,7 +46,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
 
     // The sphere's binary data: positions, normals, indices.
-    let (center, radius) = ([0.0f32, 0.35, 0.05], 0.22f32);
+    let (center, radius) = if instances > 1 {
+        ([0.0f32; 3], 1.0f32)
+    } else {
+        ([0.0f32, 0.35, 0.05], 0.22f32)
+    };
     let mut bin: Vec<u8> = Vec::with_capacity(verts * 24 + tris * 12);
     let mut normals: Vec<u8> = Vec::with_capacity(verts * 12);
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
@@ -74,6 +86,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
 
+    // Placements: a `side × side` grid over the floor (x, z in [-0.45, 0.45]), sizes varying.
+    let inst_at = bin.len();
+    let side = (instances as f64).sqrt().ceil() as usize;
+    let cell = 0.9 / side as f32;
+    if instances > 1 {
+        let mut scales = Vec::with_capacity(instances * 12);
+        for k in 0..instances {
+            let (i, j) = (k % side, k / side);
+            let r = cell * (0.25 + 0.2 * ((k as f32 * 0.618_034).fract()));
+            let t = [
+                -0.45 + cell * (i as f32 + 0.5),
+                r,
+                -0.45 + cell * (j as f32 + 0.5),
+            ];
+            for v in t {
+                bin.extend_from_slice(&v.to_le_bytes());
+            }
+            for v in [r, r * 0.8, r] {
+                scales.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        bin.extend_from_slice(&scales);
+    }
+
     let views = doc["bufferViews"].as_array_mut().unwrap();
     let v0 = views.len();
     views.push(json!({"buffer": 0, "byteOffset": 0, "byteLength": verts * 12, "target": 34962}));
@@ -102,8 +138,31 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     meshes.push(json!({"name": "sphere", "primitives": [{"attributes":
         {"POSITION": a0, "NORMAL": a0 + 1}, "indices": a0 + 2, "material": mat}]}));
     let mesh = meshes.len() - 1;
+    let mut node = json!({"name": "sphere", "mesh": mesh});
+    if instances > 1 {
+        let views = doc["bufferViews"].as_array_mut().unwrap();
+        let v = views.len();
+        for k in 0..2 {
+            views.push(
+                json!({"buffer": 0, "byteOffset": inst_at + k * instances * 12,
+                "byteLength": instances * 12}),
+            );
+        }
+        let accessors = doc["accessors"].as_array_mut().unwrap();
+        let a = accessors.len();
+        for k in 0..2 {
+            accessors.push(json!({"bufferView": v + k, "componentType": 5126,
+                "count": instances, "type": "VEC3"}));
+        }
+        node["extensions"] = json!({"EXT_mesh_gpu_instancing":
+            {"attributes": {"TRANSLATION": a, "SCALE": a + 1}}});
+        match doc["extensionsUsed"].as_array_mut() {
+            Some(used) => used.push(json!("EXT_mesh_gpu_instancing")),
+            None => doc["extensionsUsed"] = json!(["EXT_mesh_gpu_instancing"]),
+        }
+    }
     let nodes = doc["nodes"].as_array_mut().ok_or("no nodes")?;
-    nodes.push(json!({"name": "sphere", "mesh": mesh}));
+    nodes.push(node);
     let node = nodes.len() - 1;
     doc["scenes"][0]["nodes"]
         .as_array_mut()
@@ -133,8 +192,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     f.write_all(&bin)?;
     f.flush()?;
     println!(
-        "{out}: {} triangles ({tris} in the sphere, {verts} vertices), {:.1} MB",
-        tris + cornell.triangle_count(),
+        "{out}: {} triangles ({tris} in the sphere, {verts} vertices, placed {instances} times), {:.1} MB",
+        tris * instances + cornell.triangle_count(),
         total as f64 / 1e6
     );
     Ok(())

@@ -23,7 +23,7 @@ pub const MAX_COORD: f32 = 1e12;
 
 /// Up to this many triangles a ray tests each one instead of traversing the BVH (an area
 /// light's few triangles in the emitter BVH, tiny scenes).
-const BRUTE_FORCE: usize = 8;
+pub(crate) const BRUTE_FORCE: usize = 8;
 
 /// A triangle prepared for intersection: `v0` and the edges `e1 = v1 - v0`, `e2 = v2 - v0`.
 #[derive(Clone, Copy, Debug)]
@@ -51,7 +51,12 @@ pub struct Hit {
     /// `e1 × e2`: the unnormalised geometric normal by the right-hand rule (zero for a
     /// degenerate triangle).
     pub ng: Vec3,
+    /// The instance whose mesh was hit ([`NO_INSTANCE`] for a world-space mesh).
+    pub instance: u32,
 }
+
+/// [`Hit::instance`] of a world-space mesh.
+pub const NO_INSTANCE: u32 = u32::MAX;
 
 /// A BVH over triangles.
 pub struct Accel {
@@ -147,6 +152,16 @@ impl Accel {
         Accel { bvh, tris, keys }
     }
 
+    /// Number of triangles.
+    pub fn len(&self) -> usize {
+        self.tris.len()
+    }
+
+    /// Whether there is no triangle.
+    pub fn is_empty(&self) -> bool {
+        self.tris.is_empty()
+    }
+
     /// Closest hit of the ray `o + t d` with `t` in `(tmin, tmax)`.
     pub fn intersect(&self, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
         self.intersect_with(&mut Traversal::default(), o, d, tmin, tmax)
@@ -212,6 +227,7 @@ impl Accel {
             v,
             p: (tri.v0 + tri.e1 * u + tri.e2 * v).into(),
             ng: tri.e1.cross(tri.e2).into(),
+            instance: NO_INSTANCE,
         }
     }
 
@@ -266,7 +282,7 @@ impl Accel {
 /// Replaces `-0.0` components by `+0.0`: obvhs takes the traversal octant from the sign test
 /// `< 0` but inverts `-0.0` to `-1/ε`, so a direction with a negative zero misses everything.
 #[inline(always)]
-fn positive_zeros(d: Vec3) -> Vec3 {
+pub(crate) fn positive_zeros(d: Vec3) -> Vec3 {
     d + Vec3::ZERO
 }
 

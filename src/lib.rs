@@ -11,6 +11,7 @@ pub mod denoise;
 pub mod emitter;
 pub mod film;
 pub mod frame;
+pub mod instancing;
 pub mod integrator;
 pub mod output;
 pub mod protocol;

@@ -858,9 +858,11 @@ fn run_info(path: &Path) -> ExitCode {
         Ok(s) => {
             println!("{}", path.display());
             println!(
-                "  meshes: {}, triangles: {}",
+                "  meshes: {}, triangles: {}, instances: {}, triangles placed: {}",
                 s.meshes.len(),
-                s.triangle_count()
+                s.triangle_count(),
+                s.instances.len(),
+                s.instanced_triangle_count()
             );
             println!("  materials: {}", s.materials.len());
             for m in &s.materials {

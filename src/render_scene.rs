@@ -1,7 +1,7 @@
 //! A scene prepared for rendering: the BVH, the emitters and the light-selection
 //! distribution, with the surface queries the integrators need.
 
-use crate::accel::{Accel, Hit, Traversal, offset_origin};
+use crate::accel::{Accel, Hit, NO_INSTANCE, Traversal, offset_origin};
 use crate::emitter::light_bvh::LightBvh;
 use crate::emitter::light_tree::LightBounds;
 use crate::emitter::{
@@ -10,6 +10,7 @@ use crate::emitter::{
 };
 use crate::emitter::{AreaLight, SphereLight};
 use crate::frame::Frame;
+use crate::instancing::InstanceAccel;
 use crate::integrator::MAX_TRANSPARENT;
 use crate::integrator::mis_weight;
 use crate::scene::{Light, Scene};
@@ -32,6 +33,8 @@ pub struct Intersection {
     pub ns: Vec3,
     pub uv: Vec2,
     pub mesh: u32,
+    /// The instance placing the mesh ([`NO_INSTANCE`] for a world-space mesh).
+    pub instance: u32,
     /// Triangle index within the mesh and barycentrics `(b1, b2)` of the hit.
     pub tri: u32,
     pub b1: f32,
@@ -128,6 +131,8 @@ pub struct Ctx {
     /// does not end. Camera-ray segments (path vertex 1, also past transparent surfaces)
     /// stop there.
     pub camera_end: Option<Vec3>,
+    /// The top level's traversal scratch, for scenes with instances.
+    pub trav_top: Traversal,
 }
 
 impl Ctx {
@@ -142,6 +147,7 @@ impl Ctx {
             log: None,
             trav: Traversal::default(),
             camera_end: None,
+            trav_top: Traversal::default(),
         }
     }
 
@@ -171,7 +177,10 @@ pub struct RenderScene {
     passes: bool,
     /// The camera in Blender's coordinates, for the graph's Camera coordinates.
     camera_to_world: Mat4,
+    /// The world-space meshes.
     accel: Accel,
+    /// The instances (two levels), if any.
+    instances: Option<InstanceAccel>,
     /// A BVH over the emissive triangles alone: rays whose only use is the emission they meet
     /// find it here first (see [`RenderScene::emission_along`]). `None` when emissive
     /// triangles are most of the scene.
@@ -199,15 +208,6 @@ pub struct RenderScene {
 impl RenderScene {
     /// Builds the BVH and the emitters. Emissive meshes of zero area are skipped with a warning.
     pub fn new(mut scene: Scene, choice: LightChoice) -> RenderScene {
-        // Triangles go straight from the meshes into the builder: no copy of the scene at the
-        // build's peak memory.
-        let (n, tris, keys) = mesh_triangles(&scene, |_| true);
-        let accel = Accel::build_from(n, tris, keys);
-        let radius = match scene.bounds() {
-            Some((lo, hi)) => ((hi - lo) * 0.5).length().max(1e-3),
-            None => 1.0,
-        };
-
         let mut warnings = Vec::new();
         let programs: Vec<Arc<Program>> = scene
             .materials
@@ -222,6 +222,17 @@ impl RenderScene {
                 Arc::new(c.program)
             })
             .collect();
+        bake_emissive_instances(&mut scene, &programs);
+        // Triangles go straight from the meshes into the builder: no copy of the scene at the
+        // build's peak memory.
+        let placed = scene.placed_meshes();
+        let (n, tris, keys) = mesh_triangles(&scene, |i| !placed[i]);
+        let accel = Accel::build_from(n, tris, keys);
+        let instances = InstanceAccel::new(&scene, |_| true);
+        let radius = match scene.bounds() {
+            Some((lo, hi)) => ((hi - lo) * 0.5).length().max(1e-3),
+            None => 1.0,
+        };
         let camera_to_world = scene.camera.map_or(Mat4::IDENTITY, |c| {
             let b = Mat4::from_cols(
                 glam::Vec4::X,
@@ -235,7 +246,9 @@ impl RenderScene {
         let mut mesh_emitter = vec![None; scene.meshes.len()];
         for (mi, m) in scene.meshes.iter().enumerate() {
             let program = &programs[m.material];
-            if !program.may_emit() {
+            // Placed meshes emit through their baked copies; a mesh emptied by the baking
+            // has no positions left.
+            if placed[mi] || m.positions.is_empty() || !program.may_emit() {
                 continue;
             }
             match AreaEmitter::with_program(&scene, mi, program.clone()) {
@@ -321,6 +334,7 @@ impl RenderScene {
             programs,
             camera_to_world,
             accel,
+            instances,
             emitter_accel,
             triangles: n,
             emitters,
@@ -478,10 +492,29 @@ impl RenderScene {
     #[inline]
     pub fn intersect(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Option<Intersection> {
         ctx.cast(o, d, f32::INFINITY, RayKind::Closest);
-        let hit = self
-            .accel
-            .intersect_with(&mut ctx.trav, o, d, 0.0, f32::INFINITY)?;
+        let hit = self.closest(ctx, o, d, f32::INFINITY)?;
         Some(self.intersection(&hit, d))
+    }
+
+    /// The closest hit in `(0, tmax)` over the world-space meshes and the instances.
+    #[inline(always)]
+    fn closest(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32) -> Option<Hit> {
+        let hit = self.accel.intersect_with(&mut ctx.trav, o, d, 0.0, tmax);
+        let Some(inst) = &self.instances else {
+            return hit;
+        };
+        let t = hit.map_or(tmax, |h| h.t);
+        inst.intersect_with(&mut ctx.trav_top, &mut ctx.trav, o, d, 0.0, t)
+            .or(hit)
+    }
+
+    /// Whether anything lies on the ray in `(0, tmax)`.
+    #[inline(always)]
+    fn occluded(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32) -> bool {
+        self.accel.occluded_with(&mut ctx.trav, o, d, 0.0, tmax)
+            || self.instances.as_ref().is_some_and(|inst| {
+                inst.occluded_with(&mut ctx.trav_top, &mut ctx.trav, o, d, 0.0, tmax)
+            })
     }
 
     /// The radiance a ray from `o` along the unit direction `d` meets — the emission of the
@@ -509,13 +542,13 @@ impl RenderScene {
             }
             // Only a nearer surface can block it (`t < hit.t` excludes the emitter itself:
             // both BVHs hold the same triangle, intersected with the same arithmetic).
-            if self.accel.occluded_with(&mut ctx.trav, o, d, 0.0, hit.t) {
+            if self.occluded(ctx, o, d, hit.t) {
                 return None;
             }
             return Some((e, le, rec));
         }
         self.background?;
-        if (self.accel).occluded_with(&mut ctx.trav, o, d, 0.0, f32::INFINITY) {
+        if self.occluded(ctx, o, d, f32::INFINITY) {
             return None;
         }
         self.background_radiance(d, o, ctx.depth, ctx.ray_flags)
@@ -601,7 +634,7 @@ impl RenderScene {
     fn segment_transmittance(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32) -> Vec3 {
         if !self.passes {
             ctx.cast(o, d, tmax, RayKind::Any);
-            return if self.accel.occluded_with(&mut ctx.trav, o, d, 0.0, tmax) {
+            return if self.occluded(ctx, o, d, tmax) {
                 Vec3::ZERO
             } else {
                 Vec3::ONE
@@ -611,7 +644,7 @@ impl RenderScene {
         let mut tr = Vec3::ONE;
         for _ in 0..=MAX_TRANSPARENT {
             ctx.cast(o, d, tmax, RayKind::Closest);
-            let Some(hit) = self.accel.intersect_with(&mut ctx.trav, o, d, 0.0, tmax) else {
+            let Some(hit) = self.closest(ctx, o, d, tmax) else {
                 return tr;
             };
             let its = self.intersection(&hit, d);
@@ -642,7 +675,16 @@ impl RenderScene {
         };
         // Vertex attributes only when the mesh has them (position and geometric normal come
         // with the hit).
-        let ns = mesh.shading_normal(ti, b1, b2).unwrap_or(ng);
+        let (ns, material) = if hit.instance == NO_INSTANCE {
+            (mesh.shading_normal(ti, b1, b2).unwrap_or(ng), mesh.material)
+        } else {
+            let inst = &self.scene.instances[hit.instance as usize];
+            let ns = mesh
+                .interpolate(&mesh.normals, ti, b1, b2)
+                .and_then(|n| (inst.normal_matrix() * n).try_normalize())
+                .unwrap_or(ng);
+            (ns, inst.material.unwrap_or(mesh.material))
+        };
         if ng.dot(ns) < 0.0 {
             ng = -ng;
         }
@@ -656,10 +698,11 @@ impl RenderScene {
             ns,
             uv,
             mesh: mi,
+            instance: hit.instance,
             tri: ti,
             b1,
             b2,
-            material: mesh.material as u32,
+            material: material as u32,
             emitter: self.mesh_emitter[mi as usize],
         }
     }
@@ -709,10 +752,10 @@ impl RenderScene {
             }
             let (d, tmax) = (d / dist, dist * (1.0 - 1e-6));
             ctx.cast(o, d, tmax, RayKind::Any);
-            !self.accel.occluded_with(&mut ctx.trav, o, d, 0.0, tmax)
+            !self.occluded(ctx, o, d, tmax)
         } else {
             ctx.cast(o, rec.wi, f32::INFINITY, RayKind::Any);
-            !(self.accel).occluded_with(&mut ctx.trav, o, rec.wi, 0.0, f32::INFINITY)
+            !self.occluded(ctx, o, rec.wi, f32::INFINITY)
         }
     }
 
@@ -748,6 +791,7 @@ impl RenderScene {
             i: to_blender(-d),
             backfacing,
             mesh: Some(&self.scene.meshes[its.mesh as usize]),
+            instance: self.scene.instances.get(its.instance as usize),
             tri: its.tri,
             b1: its.b1,
             b2: its.b2,
@@ -937,8 +981,43 @@ impl RenderScene {
         &self.accel
     }
 
-    pub fn triangle_count(&self) -> usize {
-        self.triangles
+    /// Triangles rendered: world-space meshes once, placed meshes once per instance.
+    pub fn triangle_count(&self) -> u64 {
+        self.triangles as u64 + self.instances.as_ref().map_or(0, |i| i.triangles())
+    }
+}
+
+/// Replaces each instance whose material may emit by a world-space copy of its mesh, so
+/// that area emitters sample the instance's own triangles (areas under its scale).
+fn bake_emissive_instances(scene: &mut Scene, programs: &[Arc<Program>]) {
+    let emits = |scene: &Scene, i: &crate::scene::Instance| {
+        let Some(mesh) = scene.meshes.get(i.mesh) else {
+            return false;
+        };
+        let m = i.material.unwrap_or(mesh.material);
+        programs.get(m).is_some_and(|p| p.may_emit())
+    };
+    if !scene.instances.iter().any(|i| emits(scene, i)) {
+        return;
+    }
+    let was_placed = scene.placed_meshes();
+    let instances = std::mem::take(&mut scene.instances);
+    for inst in instances {
+        if emits(scene, &inst) {
+            let baked = scene.meshes[inst.mesh].placed(&inst);
+            scene.meshes.push(baked);
+        } else {
+            scene.instances.push(inst);
+        }
+    }
+    // A mesh whose every instance was baked must not be drawn in its object space.
+    let placed = scene.placed_meshes();
+    for (mi, was) in was_placed.into_iter().enumerate() {
+        if was && !placed[mi] {
+            let m = &mut scene.meshes[mi];
+            m.indices = Vec::new();
+            m.positions = Vec::new();
+        }
     }
 }
 

@@ -12,6 +12,7 @@ from .buffer import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT, UINT, Buffer
 from .camera import camera_extension, camera_fields, camera_matrix
 from .common import ExportCancelled, gltf_matrix, matrix
 from .images import ImageTable, Textures
+from .instances import collapse
 from .light import convert_light
 from .material import DEFAULT_MATERIAL, MaterialReport, export_material
 from .mesh import MESHLIKE, mesh_arrays, object_extras
@@ -26,6 +27,7 @@ class ExportResult:
         self.has_camera = False
         self.gltf_path = None
         self.bin_path = None
+        self.instanced_nodes = 0  # nodes folded into EXT_mesh_gpu_instancing
 
 
 def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settings=None,
@@ -54,6 +56,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     report = MaterialReport(warnings, res.material_warnings)
     images = ImageTable(buf, report)
     mesh_cache = {}
+    mesh_nodes = {}  # glTF mesh index -> nodes placing it
     khr_lights = []
 
     def mat_idx(mat):
@@ -157,6 +160,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             extras = {"tesela_object": object_extras(inst, obj)}
             if texspace is not None:
                 extras["tesela_texspace"] = {"location": texspace[0], "size": texspace[1]}
+            mesh_nodes.setdefault(mi, []).append(len(doc["nodes"]))
             add_node({"name": obj.name, "mesh": mi, "matrix": gltf_matrix(matrix(inst.matrix_world)),
                       "extras": extras})
         elif otype in ("CURVES", "POINTCLOUD", "VOLUME", "GPENCIL", "GREASEPENCIL"):
@@ -175,6 +179,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                 node["extensions"]["KHR_lights_punctual"] = {"light": len(khr_lights) - 1}
                 used_ext.add("KHR_lights_punctual")
             add_node(node)
+
+    res.instanced_nodes = collapse(doc, root_nodes, buf, mesh_nodes, used_ext)
 
     cam = camera if camera is not None else scene.camera
     if cam is not None and cam.type == "CAMERA":

@@ -82,7 +82,10 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), String> {
     };
     let mut meshes = Vec::new();
     let mut nodes = Vec::new();
-    for m in &scene.meshes {
+    // Placed meshes get no node of their own: their instances are nodes referring to them
+    // (another glTF mesh over the same accessors where an instance overrides the material).
+    let placed = scene.placed_meshes();
+    for (mi, m) in scene.meshes.iter().enumerate() {
         let pos: Vec<f32> = m.positions.iter().flat_map(|p| p.to_array()).collect();
         let mut attributes = json!({"POSITION": buf.floats(&pos, "VEC3", m.positions.len(), true)});
         if !m.normals.is_empty() {
@@ -98,7 +101,24 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), String> {
         meshes.push(json!({"name": m.name, "primitives": [{
             "attributes": attributes, "indices": indices, "material": m.material
         }]}));
-        nodes.push(json!({"name": m.name, "mesh": meshes.len() - 1}));
+        let own = meshes.len() - 1;
+        if !placed[mi] {
+            nodes.push(json!({"name": m.name, "mesh": own}));
+            continue;
+        }
+        let mut by_material = std::collections::HashMap::new();
+        by_material.insert(m.material, own);
+        for inst in scene.instances.iter().filter(|i| i.mesh == mi) {
+            let mat = inst.material.unwrap_or(m.material);
+            let mesh = *by_material.entry(mat).or_insert_with(|| {
+                let mut copy = meshes[own].clone();
+                copy["primitives"][0]["material"] = json!(mat);
+                meshes.push(copy);
+                meshes.len() - 1
+            });
+            nodes.push(json!({"name": m.name, "mesh": mesh,
+                "matrix": inst.to_world.to_cols_array()}));
+        }
     }
     let materials: Vec<Value> = scene
         .materials

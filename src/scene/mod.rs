@@ -1,6 +1,8 @@
 //! The renderer's scene description: everything the loaders produce and the renderer consumes.
 //!
-//! All geometry is flattened to **world space** (right-handed, +Y up as in glTF, metres).
+//! Geometry is in **world space** (right-handed, +Y up as in glTF, metres), except the meshes
+//! that [`Scene::instances`] place: those are in their own object space and are seen only
+//! through their instances' transforms (see [`instance`]).
 //! Colours are **linear** RGB; radiometric quantities are in watts (W/sr for intensity,
 //! W/m² for irradiance, W/(m² sr) for radiance).
 
@@ -8,15 +10,18 @@ pub mod builtin;
 pub mod error;
 pub mod gltf;
 pub mod gltf_write;
+pub mod instance;
 pub mod world;
 
 pub use error::{LoadError, LoadErrorKind};
+pub use instance::Instance;
 pub use world::{World, WorldSampling};
 
 use glam::{Mat4, Vec2, Vec3};
 use std::sync::Arc;
 
-/// A triangle mesh in world space with one material.
+/// A triangle mesh with one material, in world space, or in object space when instances
+/// place it (see [`Scene::instances`]); "world space" below means the mesh's space.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
     pub name: String,
@@ -101,6 +106,13 @@ impl Default for MeshAttributes {
 }
 
 impl Mesh {
+    /// Axis-aligned bounds of the vertices, `None` without any.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let lo = self.positions.iter().fold(Vec3::INFINITY, |l, p| l.min(*p));
+        let hi = (self.positions.iter()).fold(Vec3::NEG_INFINITY, |h, p| h.max(*p));
+        lo.cmple(hi).all().then_some((lo, hi))
+    }
+
     /// The three vertex indices of triangle `tri`.
     #[inline(always)]
     pub fn corners(&self, tri: u32) -> [usize; 3] {
@@ -738,7 +750,10 @@ impl Mist {
 /// A complete scene.
 #[derive(Clone, Debug, Default)]
 pub struct Scene {
+    /// Meshes no instance refers to are in world space; the others in object space.
     pub meshes: Vec<Mesh>,
+    /// Placements of object-space meshes (a mesh may be placed many times).
+    pub instances: Vec<Instance>,
     pub materials: Vec<Material>,
     pub textures: Vec<Texture>,
     pub images: Vec<Image>,
@@ -754,22 +769,62 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// Axis-aligned bounds of all mesh vertices, or `None` for a scene without geometry.
+    /// Axis-aligned world-space bounds of all geometry (instances by their transformed mesh
+    /// bounds), or `None` for a scene without geometry.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let placed = self.placed_meshes();
         let mut lo = Vec3::splat(f32::INFINITY);
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
         let mut any = false;
-        for m in &self.meshes {
+        for (m, _) in self.meshes.iter().zip(&placed).filter(|(_, p)| !**p) {
             for p in &m.positions {
                 lo = lo.min(*p);
                 hi = hi.max(*p);
                 any = true;
             }
         }
+        let mesh_bounds: Vec<Option<(Vec3, Vec3)>> = (self.meshes.iter().zip(&placed))
+            .map(|(m, p)| if *p { m.bounds() } else { None })
+            .collect();
+        for inst in &self.instances {
+            if let Some(Some((l, h))) = mesh_bounds.get(inst.mesh) {
+                let (l, h) = instance::transform_bounds(&inst.to_world, *l, *h);
+                lo = lo.min(l);
+                hi = hi.max(h);
+                any = true;
+            }
+        }
         any.then_some((lo, hi))
     }
 
+    /// For each mesh, whether instances place it (then it is in object space and not drawn
+    /// by itself).
+    pub fn placed_meshes(&self) -> Vec<bool> {
+        let mut placed = vec![false; self.meshes.len()];
+        for i in &self.instances {
+            if let Some(p) = placed.get_mut(i.mesh) {
+                *p = true;
+            }
+        }
+        placed
+    }
+
+    /// Triangles stored: each mesh once, however many instances place it.
     pub fn triangle_count(&self) -> usize {
         self.meshes.iter().map(|m| m.indices.len()).sum()
+    }
+
+    /// Triangles rendered: world-space meshes once, placed meshes once per instance.
+    pub fn instanced_triangle_count(&self) -> u64 {
+        let placed = self.placed_meshes();
+        let own: u64 = (self.meshes.iter().zip(&placed))
+            .filter(|(_, p)| !**p)
+            .map(|(m, _)| m.indices.len() as u64)
+            .sum();
+        let inst: u64 = (self.instances.iter())
+            .filter_map(|i| self.meshes.get(i.mesh))
+            .map(|m| m.indices.len() as u64)
+            .sum();
+        own + inst
     }
 }

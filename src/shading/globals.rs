@@ -5,7 +5,7 @@
 //! positions, normals and directions are converted from the renderer's Y-up world once, here,
 //! and BSDF normals back when the closures are read.
 
-use crate::scene::{Image, Mesh, Texture};
+use crate::scene::{Image, Instance, Mesh, ObjectInfo, Texture};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 /// Renderer world (glTF, Y up) → Blender world (Z up).
@@ -54,6 +54,8 @@ pub struct ShaderGlobals<'a> {
     pub backfacing: bool,
     /// The mesh, triangle and barycentrics `(b1, b2)` of the point, when on a mesh.
     pub mesh: Option<&'a Mesh>,
+    /// The instance placing `mesh` (then the mesh's data is in its object space).
+    pub instance: Option<&'a Instance>,
     pub tri: u32,
     pub b1: f32,
     pub b2: f32,
@@ -80,6 +82,7 @@ impl<'a> ShaderGlobals<'a> {
             i: n,
             backfacing: false,
             mesh: None,
+            instance: None,
             tri: 0,
             b1: 0.0,
             b2: 0.0,
@@ -109,8 +112,8 @@ impl<'a> ShaderGlobals<'a> {
         if let Some(m) = self.mesh {
             let [i0, i1, i2] = m.corners(self.tri);
             let (e1, e2) = (
-                m.positions[i1] - m.positions[i0],
-                m.positions[i2] - m.positions[i0],
+                self.mesh_to_world(m.positions[i1] - m.positions[i0]),
+                self.mesh_to_world(m.positions[i2] - m.positions[i0]),
             );
             // dP = db1 e1 + db2 e2 in the triangle's plane (least squares, glTF space).
             let d = from_blender(dp);
@@ -157,11 +160,41 @@ impl<'a> ShaderGlobals<'a> {
         m.interpolate(&set.1, self.tri, self.b1, self.b2)
     }
 
+    /// A vector of the mesh's space in the renderer's world space (glTF axes).
+    #[inline(always)]
+    fn mesh_to_world(&self, v: Vec3) -> Vec3 {
+        match self.instance {
+            Some(i) => i.to_world.transform_vector3(v),
+            None => v,
+        }
+    }
+
+    /// Renderer world (glTF axes) → object space, when on a mesh: the instance's inverse
+    /// transform followed by the mesh's own world → object map.
+    #[inline]
+    pub fn to_object(&self) -> Option<Mat4> {
+        let m = self.mesh?;
+        Some(match self.instance {
+            Some(i) => m.attrs.to_object * i.to_world.inverse(),
+            None => m.attrs.to_object,
+        })
+    }
+
+    /// Blender's Object Info of the point's object (the instance's own, if placed).
+    #[inline]
+    pub fn object_info(&self) -> Option<&'a ObjectInfo> {
+        match (self.instance, self.mesh) {
+            (Some(i), _) => Some(&i.object),
+            (None, Some(m)) => Some(&m.attrs.object),
+            _ => None,
+        }
+    }
+
     /// Position in object space (the object's own coordinates, as the add-on wrote them).
     #[inline]
     pub fn object_position(&self) -> Vec3 {
-        match self.mesh {
-            Some(m) => m.attrs.to_object.transform_point3(from_blender(self.p)),
+        match self.to_object() {
+            Some(m) => m.transform_point3(from_blender(self.p)),
             None => self.p,
         }
     }
@@ -169,8 +202,8 @@ impl<'a> ShaderGlobals<'a> {
     /// World → object transform for directions (unnormalised).
     #[inline]
     pub fn object_direction(&self, v: Vec3) -> Vec3 {
-        match self.mesh {
-            Some(m) => m.attrs.to_object.transform_vector3(from_blender(v)),
+        match self.to_object() {
+            Some(m) => m.transform_vector3(from_blender(v)),
             None => v,
         }
     }
@@ -193,11 +226,13 @@ impl<'a> ShaderGlobals<'a> {
     /// vertex tangents when it has them, else the triangle's `dp/du`.
     pub fn tangent(&self) -> Option<(Vec3, f32)> {
         let m = self.mesh?;
+        // A mirroring instance flips the bitangent's handedness (as baking it does).
+        let mirror = self.instance.is_some_and(|i| i.mirrors());
         if let Some(t) = m.interpolate(&m.attrs.tangents, self.tri, self.b1, self.b2) {
-            let v = to_blender(t.truncate());
+            let v = to_blender(self.mesh_to_world(t.truncate()));
             let l = v.length();
             if l > 1e-12 && l.is_finite() {
-                return Some((v / l, if t.w < 0.0 { -1.0 } else { 1.0 }));
+                return Some((v / l, if (t.w < 0.0) != mirror { -1.0 } else { 1.0 }));
             }
         }
         // dp/du from the triangle (glTF uv: v runs down, Blender's up).
@@ -206,6 +241,7 @@ impl<'a> ShaderGlobals<'a> {
         }
         let [i0, i1, i2] = m.corners(self.tri);
         let (p0, p1, p2) = (m.positions[i0], m.positions[i1], m.positions[i2]);
+        let (e1, e2) = (self.mesh_to_world(p1 - p0), self.mesh_to_world(p2 - p0));
         let (t0, t1, t2) = (m.uvs[i0], m.uvs[i1], m.uvs[i2]);
         let (du1, dv1) = (t1.x - t0.x, t0.y - t1.y);
         let (du2, dv2) = (t2.x - t0.x, t0.y - t2.y);
@@ -213,10 +249,11 @@ impl<'a> ShaderGlobals<'a> {
         if det.abs() < 1e-20 {
             return None;
         }
-        let dpdu = ((p1 - p0) * dv2 - (p2 - p0) * dv1) / det;
-        let dpdv = ((p2 - p0) * du1 - (p1 - p0) * du2) / det;
-        let ng = (p1 - p0).cross(p2 - p0);
-        let sign = if ng.cross(dpdu).dot(dpdv) < 0.0 {
+        let dpdu = (e1 * dv2 - e2 * dv1) / det;
+        let dpdv = (e2 * du1 - e1 * du2) / det;
+        // The front side's normal: a mirrored instance's edges turn the other way.
+        let ng = e1.cross(e2);
+        let sign = if (ng.cross(dpdu).dot(dpdv) < 0.0) != mirror {
             -1.0
         } else {
             1.0

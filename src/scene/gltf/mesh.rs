@@ -211,12 +211,17 @@ fn default_name(base: &str, k: usize) -> String {
 }
 
 impl<'a> Loader<'a> {
+    /// Bakes mesh `mi` of node `ni` into world space by `world`; with `object_space`, stores it
+    /// in its own space instead (identity `world`, for instances to place). Returns the range
+    /// of [`crate::scene::Scene::meshes`] its primitives became.
     pub(crate) fn instance_mesh(
         &mut self,
         ni: usize,
         mi: usize,
         world: Mat4,
-    ) -> Result<(), LoadError> {
+        object_space: bool,
+    ) -> Result<std::ops::Range<usize>, LoadError> {
+        let first = self.scene.meshes.len();
         let root = self.root;
         let mesh = root.meshes.get(mi).ok_or_else(|| {
             invalid(format!(
@@ -282,7 +287,7 @@ impl<'a> Loader<'a> {
             prims.push((pi, local, material));
         }
         if prims.is_empty() {
-            return Ok(());
+            return Ok(first..first);
         }
         // Per-object data: the node's extras (written by the add-on) or what the file implies.
         let extras = member(self.raw_item("nodes", ni), "extras");
@@ -312,7 +317,11 @@ impl<'a> Loader<'a> {
             }
             (lo.cmple(hi).all()).then(|| auto_texspace(lo, hi))
         });
-        let object = self.object_info(ni, extras, world);
+        let object = if object_space {
+            ObjectInfo::default()
+        } else {
+            self.object_info(ni, extras, world)
+        };
         let to_object = Some(world.inverse())
             .filter(|m| m.is_finite())
             .unwrap_or(Mat4::IDENTITY);
@@ -368,12 +377,17 @@ impl<'a> Loader<'a> {
                 attrs,
             });
         }
-        Ok(())
+        Ok(first..self.scene.meshes.len())
     }
 
     /// Object Info data of node `ni`: `extras.tesela_object` (Blender's world coordinates),
     /// else defaults with the node's origin as the location.
-    fn object_info(&mut self, ni: usize, extras: Option<&Value>, world: Mat4) -> ObjectInfo {
+    pub(crate) fn object_info(
+        &mut self,
+        ni: usize,
+        extras: Option<&Value>,
+        world: Mat4,
+    ) -> ObjectInfo {
         let mut info = ObjectInfo {
             location: world.w_axis.truncate(),
             ..Default::default()
@@ -748,9 +762,23 @@ impl<'a> Loader<'a> {
                         what("indices")
                     )));
                 }
+                if mode == Mode::Triangles && idx.len() % 3 != 0 {
+                    self.warn_once(format!(
+                        "accessor {ai} ({}): {} indices are not a multiple of 3 for TRIANGLES; the last {} are dropped",
+                        what("indices"),
+                        idx.len(),
+                        idx.len() % 3
+                    ));
+                }
                 triangulate(mode, &idx)
             }
             None => {
+                if mode == Mode::Triangles && count % 3 != 0 {
+                    self.warn_once(format!(
+                        "mesh {mi} primitive {pi}: {count} vertices without indices are not a multiple of 3 for TRIANGLES; the last {} are dropped",
+                        count % 3
+                    ));
+                }
                 let idx: Vec<u32> = (0..vcount).collect();
                 triangulate(mode, &idx)
             }

@@ -14,6 +14,7 @@
 mod accessor;
 mod camera;
 mod container;
+mod instances;
 mod lights;
 mod material;
 mod mesh;
@@ -46,6 +47,7 @@ const MAX_VERTICES: usize = 1 << 25;
 /// Extensions that may appear in `extensionsRequired`.
 const SUPPORTED_REQUIRED: &[&str] = &[
     "KHR_mesh_quantization",
+    "EXT_mesh_gpu_instancing",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
     "KHR_materials_transmission",
@@ -70,6 +72,7 @@ const SUPPORTED_REQUIRED: &[&str] = &[
 /// reports it. Volume attenuation, which is not rendered yet, is reported by the loader.
 const UNDERSTOOD: &[&str] = &[
     "KHR_mesh_quantization",
+    "EXT_mesh_gpu_instancing",
     "KHR_texture_transform",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
@@ -504,6 +507,7 @@ impl<'a> Loader<'a> {
         let mut visited = vec![false; n];
         let mut stack: Vec<(usize, Mat4)> =
             roots.iter().rev().map(|&r| (r, Mat4::IDENTITY)).collect();
+        let mut uses = Vec::new();
         while let Some((ni, parent)) = stack.pop() {
             let node =
                 self.root.nodes.get(ni).ok_or_else(|| {
@@ -527,14 +531,28 @@ impl<'a> Loader<'a> {
                 self.scene.camera = Some(self.camera(ci.value(), ni, world)?);
             }
             if let Some(mi) = node.mesh {
-                self.instance_mesh(ni, mi.value(), world)?;
+                let mi = mi.value();
+                if mi >= self.root.meshes.len() {
+                    return Err(invalid(format!(
+                        "node {ni}: mesh {mi} does not exist (the file has {})",
+                        self.root.meshes.len()
+                    )));
+                }
+                let (gpu, gpu_random) = self.gpu_instances(ni)?;
+                uses.push(instances::MeshUse {
+                    node: ni,
+                    mesh: mi,
+                    world,
+                    gpu,
+                    gpu_random,
+                });
             }
             self.node_lights(ni, world)?;
             for c in node.children.iter().flatten().rev() {
                 stack.push((c.value(), world));
             }
         }
-        Ok(())
+        self.place_meshes(uses)
     }
 }
 

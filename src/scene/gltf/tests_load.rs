@@ -120,16 +120,24 @@ fn instancing_trs_and_nested_matrices() {
     .unwrap();
     doc["scenes"][0]["nodes"] = json!([0, 1]);
     let s = load(&serde_json::to_vec(&doc).unwrap());
-    assert_eq!(s.meshes.len(), 2, "one mesh instanced twice");
-    // Second instance: scaled by 2, rotated -90° about X (+Y -> -Z), moved up 5.
-    let p = &s.meshes[1].positions;
-    assert!(p[2].abs_diff_eq(Vec3::new(0., 5., -2.), 1e-5), "{:?}", p);
-    assert!(s.meshes[1].normals[0].abs_diff_eq(Vec3::Y, 1e-5));
-    assert!(face_normal(&s, 1).abs_diff_eq(Vec3::Y, 1e-5));
-    assert_eq!(
-        s.meshes[0].material, s.meshes[1].material,
-        "one default material"
+    assert_eq!(s.meshes.len(), 1, "one mesh stored once");
+    assert_eq!(s.instances.len(), 2, "and placed twice");
+    assert!(
+        s.instances
+            .iter()
+            .all(|i| i.mesh == 0 && i.material.is_none())
     );
+    let first = s.meshes[0].placed(&s.instances[0]);
+    assert_eq!(first.positions[1], Vec3::new(11., 0., 0.));
+    // Second instance: scaled by 2, rotated -90° about X (+Y -> -Z), moved up 5.
+    let second = Scene {
+        meshes: vec![s.meshes[0].placed(&s.instances[1])],
+        ..Default::default()
+    };
+    let p = &second.meshes[0].positions;
+    assert!(p[2].abs_diff_eq(Vec3::new(0., 5., -2.), 1e-5), "{:?}", p);
+    assert!(second.meshes[0].normals[0].abs_diff_eq(Vec3::Y, 1e-5));
+    assert!(face_normal(&second, 0).abs_diff_eq(Vec3::Y, 1e-5));
     assert_eq!(s.materials.len(), 1);
 }
 
@@ -184,8 +192,11 @@ fn strips_fans_and_empty_primitives() {
     );
     assert_eq!(s.meshes[0].indices, vec![[0, 1, 2], [2, 1, 3]]);
     assert_eq!(s.meshes[1].indices, vec![[1, 2, 0], [2, 3, 0]]);
-    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
-    assert!(s.warnings[0].contains("LINES"));
+    assert_eq!(s.warnings.len(), 2, "{:?}", s.warnings);
+    assert!(
+        s.warnings[0].contains("primitive 2: 2 vertices without indices are not a multiple of 3")
+    );
+    assert!(s.warnings[1].contains("LINES"));
 }
 
 #[test]

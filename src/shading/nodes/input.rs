@@ -113,13 +113,12 @@ impl InputOp {
     #[inline]
     pub fn eval(&self, s: &mut Slots, g: &ShaderGlobals, env: &ShadeEnv) {
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
-        let info = g.mesh.map(|m| &m.attrs.object);
+        let info = g.object_info();
         match &self.src {
             Source::Generated => s.set_v(self.out, g.generated()),
             Source::ObjectNormal => s.set_v(
                 self.out,
-                g.mesh
-                    .map_or(g.n, |m| object_normal(&m.attrs.to_object, g.n)),
+                g.to_object().map_or(g.n, |m| object_normal(&m, g.n)),
             ),
             Source::Uv(name) => s.set_v(self.out, g.uv_named(name)),
             Source::GltfUv(set) => {

@@ -191,10 +191,10 @@ fn normal_map(space: NormalSpace, c: Vec3, g: &ShaderGlobals) -> Vec3 {
             let r = safe_normalize(c.x * t + c.y * b + c.z * n);
             if g.backfacing { -r } else { r }
         }
-        NormalSpace::Object => match g.mesh {
-            Some(m) => {
+        NormalSpace::Object => match g.to_object() {
+            Some(to_object) => {
                 // Object → world for normals: inverse transpose of object → world.
-                let to_world_normal = Mat3::from_mat4(m.attrs.to_object).transpose();
+                let to_world_normal = Mat3::from_mat4(to_object).transpose();
                 let r = safe_normalize(to_blender(to_world_normal * c));
                 if g.backfacing { -r } else { r }
             }

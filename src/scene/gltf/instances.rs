@@ -1,0 +1,198 @@
+//! Mesh placements: glTF meshes referenced by several nodes, and `EXT_mesh_gpu_instancing`
+//! (per-instance TRANSLATION, ROTATION, SCALE accessors applied before the node's transform:
+//! `world = node_world · T · R · S`).
+//!
+//! A mesh placed once is baked into world space as before; a mesh placed more often is stored
+//! once in its object space and placed by [`crate::scene::Instance`]s. Placements that cannot
+//! be rendered (non-finite or singular transforms, beyond the coordinate limit) are skipped
+//! with one warning per node.
+
+use glam::{Mat4, Quat, Vec3, Vec4};
+use json::accessor::Type;
+use std::collections::HashMap;
+
+use super::{LoadError, LoadErrorKind, Loader, extension, invalid, json, member};
+use crate::scene::{Instance, instance::transform_bounds};
+
+/// Most instances a file may place (about 0.5 GB of instance and BVH data).
+pub(crate) const MAX_INSTANCES: usize = 1 << 22;
+
+/// One node's use of a mesh, found by the node walk.
+pub(crate) struct MeshUse {
+    pub node: usize,
+    pub mesh: usize,
+    pub world: Mat4,
+    /// `EXT_mesh_gpu_instancing` local transforms (`T · R · S`), empty without the extension.
+    pub gpu: Vec<Mat4>,
+    /// The add-on's `_TESELA_RANDOM` attribute: each instance's Object Info random (may be
+    /// empty: then a hash of node and instance index).
+    pub gpu_random: Vec<f32>,
+}
+
+impl<'a> Loader<'a> {
+    /// The `EXT_mesh_gpu_instancing` transforms of node `ni` (empty without the extension).
+    /// Instances whose attributes are not finite or whose rotation is zero come back as a
+    /// non-finite matrix, for [`Loader::place_meshes`] to skip.
+    pub(crate) fn gpu_instances(&mut self, ni: usize) -> Result<(Vec<Mat4>, Vec<f32>), LoadError> {
+        let Some(ext) = extension(self.raw_item("nodes", ni), "EXT_mesh_gpu_instancing") else {
+            return Ok((Vec::new(), Vec::new()));
+        };
+        let Some(attrs) = member(ext, "attributes").and_then(|a| a.as_object()) else {
+            return Err(invalid(format!(
+                "node {ni}: EXT_mesh_gpu_instancing has no `attributes` object"
+            )));
+        };
+        let mut count = None;
+        let mut read = |name: &str, ty: Type| -> Result<Option<Vec<f32>>, LoadError> {
+            let Some(v) = attrs.get(name) else {
+                return Ok(None);
+            };
+            let what = format!("node {ni} EXT_mesh_gpu_instancing {name}");
+            let ai = v
+                .as_u64()
+                .and_then(|a| usize::try_from(a).ok())
+                .ok_or_else(|| invalid(format!("{what}: {v} is not an accessor index")))?;
+            let n = self.root.accessors.get(ai).map(|a| a.count.0 as usize);
+            let n = n.ok_or_else(|| {
+                invalid(format!(
+                    "{what}: accessor {ai} does not exist (the file has {})",
+                    self.root.accessors.len()
+                ))
+            })?;
+            if n > MAX_INSTANCES {
+                return Err(LoadError::new(
+                    LoadErrorKind::TooLarge,
+                    format!(
+                        "accessor {ai} ({what}): {n} instances exceed the limit of {MAX_INSTANCES}"
+                    ),
+                ));
+            }
+            if *count.get_or_insert(n) != n {
+                return Err(invalid(format!(
+                    "accessor {ai} ({what}): {n} elements where the other attributes have {}",
+                    count.unwrap_or(0)
+                )));
+            }
+            Ok(Some(self.reader.read_f32(ai, &what, ty)?.data))
+        };
+        let t = read("TRANSLATION", Type::Vec3)?;
+        let r = read("ROTATION", Type::Vec4)?;
+        let s = read("SCALE", Type::Vec3)?;
+        let random = read("_TESELA_RANDOM", Type::Scalar)?.unwrap_or_default();
+        let n = count.unwrap_or(0);
+        let v3 = |d: &Option<Vec<f32>>, k: usize, def: Vec3| {
+            d.as_ref()
+                .map_or(def, |d| Vec3::from_slice(&d[3 * k..3 * k + 3]))
+        };
+        let transforms = (0..n)
+            .map(|k| {
+                let q = r
+                    .as_ref()
+                    .map_or(Quat::IDENTITY, |d| Quat::from_slice(&d[4 * k..4 * k + 4]));
+                let len = q.length();
+                if !(len.is_finite() && len > 1e-12) {
+                    return Mat4::from_cols(Vec4::NAN, Vec4::NAN, Vec4::NAN, Vec4::NAN);
+                }
+                Mat4::from_scale_rotation_translation(
+                    v3(&s, k, Vec3::ONE),
+                    q / len,
+                    v3(&t, k, Vec3::ZERO),
+                )
+            })
+            .collect();
+        Ok((transforms, random))
+    }
+
+    /// Turns the meshes the node walk found into scene meshes: baked where a mesh is placed
+    /// once (or a node sets its own morph weights), else stored once and placed by instances.
+    pub(crate) fn place_meshes(&mut self, uses: Vec<MeshUse>) -> Result<(), LoadError> {
+        let mut placements: HashMap<usize, usize> = HashMap::new();
+        let mut total = 0usize;
+        for u in &uses {
+            let n = u.gpu.len().max(1);
+            *placements.entry(u.mesh).or_default() += n;
+            total = total.saturating_add(n);
+        }
+        if total > MAX_INSTANCES {
+            return Err(LoadError::new(
+                LoadErrorKind::TooLarge,
+                format!("the nodes place {total} meshes, beyond the limit of {MAX_INSTANCES}"),
+            ));
+        }
+        let mut stored: HashMap<usize, std::ops::Range<usize>> = HashMap::new();
+        for u in uses {
+            let own_weights = self.root.nodes[u.node].weights.is_some();
+            if u.gpu.is_empty() && (placements[&u.mesh] == 1 || own_weights) {
+                self.instance_mesh(u.node, u.mesh, u.world, false)?;
+                continue;
+            }
+            let range = match stored.get(&u.mesh) {
+                Some(r) => r.clone(),
+                None => {
+                    let r = self.instance_mesh(u.node, u.mesh, Mat4::IDENTITY, true)?;
+                    stored.insert(u.mesh, r.clone());
+                    r
+                }
+            };
+            let locals = if u.gpu.is_empty() {
+                vec![Mat4::IDENTITY]
+            } else {
+                u.gpu
+            };
+            let extras = member(self.raw_item("nodes", u.node), "extras");
+            let (mut skipped, mut why) = (0usize, "");
+            for (k, local) in locals.iter().enumerate() {
+                let world = u.world * *local;
+                let problem = Instance::check(&world).or_else(|| {
+                    (range.clone())
+                        .filter_map(|mi| self.scene.meshes[mi].bounds())
+                        .map(|(lo, hi)| transform_bounds(&world, lo, hi))
+                        .any(|(lo, hi)| {
+                            lo.abs().max(hi.abs()).max_element() > crate::accel::MAX_COORD
+                        })
+                        .then_some("it reaches beyond the renderer's coordinate limit")
+                });
+                if let Some(p) = problem {
+                    skipped += 1;
+                    why = p;
+                    continue;
+                }
+                let mut object = self.object_info(u.node, extras, world);
+                if locals.len() > 1 {
+                    object.random = match u.gpu_random.get(k) {
+                        Some(r) if r.is_finite() => *r,
+                        _ => instance_random(u.node, k),
+                    };
+                }
+                for mesh in range.clone() {
+                    self.scene.instances.push(Instance {
+                        mesh,
+                        to_world: world,
+                        material: None,
+                        object: object.clone(),
+                    });
+                }
+            }
+            if skipped > 0 {
+                self.warn_once(format!(
+                    "node {}: {skipped} of {} placements of mesh {} are skipped ({why})",
+                    u.node,
+                    locals.len(),
+                    u.mesh
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Object Info random of instance `k` of node `ni`: a hash of both, uniform in `[0, 1)`.
+fn instance_random(ni: usize, k: usize) -> f32 {
+    let mut h = (ni as u64) << 32 ^ k as u64;
+    h ^= h >> 33;
+    h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+    h ^= h >> 33;
+    h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+    h ^= h >> 33;
+    (h >> 40) as f32 / (1u64 << 24) as f32
+}
