@@ -199,6 +199,16 @@ def renderer_args(binary, gltf, settings, width, height, region, pass_names=()):
     if getattr(settings, "use_adaptive_sampling", False):
         args += ["--adaptive-threshold", repr(float(settings.adaptive_threshold)),
                  "--adaptive-min-samples", str(settings.adaptive_min_samples)]
+    for option, prop in (("--diffuse-bounces", "diffuse_bounces"),
+                         ("--glossy-bounces", "glossy_bounces"),
+                         ("--transmission-bounces", "transmission_bounces"),
+                         ("--transparent-bounces", "transparent_max_bounces")):
+        if hasattr(settings, prop):
+            args += [option, str(getattr(settings, prop))]
+    for option, prop in (("--clamp-direct", "sample_clamp_direct"),
+                         ("--clamp-indirect", "sample_clamp_indirect")):
+        if getattr(settings, prop, 0.0) > 0.0:
+            args += [option, repr(float(getattr(settings, prop)))]
     filter_type = getattr(settings, "pixel_filter_type", "BOX")
     args += ["--filter", filter_type.lower().replace("_", "-"),
              "--filter-width", repr(float(getattr(settings, "filter_width", 1.0)))]

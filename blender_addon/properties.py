@@ -26,6 +26,24 @@ class TeselaSceneSettings(bpy.types.PropertyGroup):
     seed: IntProperty(name="Seed", default=0, min=0, description="Random seed")
     threads: IntProperty(name="Threads", default=0, min=0, max=1024,
                          description="Render threads (0: all cores)")
+    diffuse_bounces: IntProperty(
+        name="Diffuse", default=4, min=0, max=1024,
+        description="Maximum number of diffuse reflection bounces, bounded by Max Depth")
+    glossy_bounces: IntProperty(
+        name="Glossy", default=4, min=0, max=1024,
+        description="Maximum number of glossy reflection bounces, bounded by Max Depth")
+    transmission_bounces: IntProperty(
+        name="Transmission", default=12, min=0, max=1024,
+        description="Maximum number of transmission bounces, bounded by Max Depth")
+    transparent_max_bounces: IntProperty(
+        name="Transparent", default=8, min=0, max=1024,
+        description="Maximum number of transparent surfaces passed straight through")
+    sample_clamp_direct: FloatProperty(
+        name="Direct Light", default=0.0, min=0.0,
+        description="If non-zero, the maximum value for a direct light sample")
+    sample_clamp_indirect: FloatProperty(
+        name="Indirect Light", default=10.0, min=0.0,
+        description="If non-zero, the maximum value for an indirect light sample")
     use_adaptive_sampling: BoolProperty(
         name="Noise Threshold", default=True,
         description="Automatically stop sampling pixels whose noise falls below the threshold "

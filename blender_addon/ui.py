@@ -69,6 +69,12 @@ class TESELA_PT_render(bpy.types.Panel):
         layout.prop(s, "denoising_store_passes")
         col = layout.column(heading="Light Paths")
         col.prop(s, "max_depth")
+        for prop in ("diffuse_bounces", "glossy_bounces", "transmission_bounces",
+                     "transparent_max_bounces"):
+            col.prop(s, prop)
+        col = layout.column(heading="Clamping")
+        col.prop(s, "sample_clamp_direct")
+        col.prop(s, "sample_clamp_indirect")
         col = layout.column(heading="Film")
         col.prop(context.scene.render, "film_transparent", text="Transparent")
         col.prop(s, "pixel_filter_type")

@@ -155,6 +155,25 @@ struct RenderArgs {
     /// Python environment with pyoidn, then the system's library path.
     #[arg(long, value_name = "PATH")]
     oidn_lib: Option<PathBuf>,
+    /// Most diffuse bounces (Cycles' diffuse_bounces); default: no limit besides --max-depth.
+    #[arg(long, value_name = "N")]
+    diffuse_bounces: Option<u32>,
+    /// Most glossy bounces (Cycles' glossy_bounces).
+    #[arg(long, value_name = "N")]
+    glossy_bounces: Option<u32>,
+    /// Most transmission bounces (Cycles' transmission_bounces).
+    #[arg(long, value_name = "N")]
+    transmission_bounces: Option<u32>,
+    /// Most transparent surfaces passed straight through (Cycles' transparent_max_bounces).
+    #[arg(long, default_value_t = 8, value_name = "N")]
+    transparent_bounces: u32,
+    /// Clamp direct light: a sample's |R|+|G|+|B| above this is scaled down to it (Cycles'
+    /// sample_clamp_direct; 0 = off). Path integrators.
+    #[arg(long, default_value_t = 0.0, value_name = "C")]
+    clamp_direct: f32,
+    /// Clamp indirect light (Cycles' sample_clamp_indirect; 0 = off). Path integrators.
+    #[arg(long, default_value_t = 0.0, value_name = "C")]
+    clamp_indirect: f32,
     /// Pixel filter (Cycles' pixel_filter_type): box, gaussian or blackman-harris.
     #[arg(long, default_value = "box", value_parser = ["box", "gaussian", "blackman-harris"])]
     filter: String,
@@ -463,6 +482,14 @@ fn options(args: &RenderArgs, scene: &Scene) -> RenderOptions {
                 min_samples: args.adaptive_min_samples.unwrap_or(0),
             }),
         time_limit: args.time_limit,
+        light_paths: tesela::integrator::light_paths::LightPaths {
+            diffuse: args.diffuse_bounces.unwrap_or(u32::MAX),
+            glossy: args.glossy_bounces.unwrap_or(u32::MAX),
+            transmission: args.transmission_bounces.unwrap_or(u32::MAX),
+            transparent: args.transparent_bounces,
+            clamp_direct: args.clamp_direct,
+            clamp_indirect: args.clamp_indirect,
+        },
         filter: tesela::film::PixelFilter::new(
             match args.filter.as_str() {
                 "gaussian" => tesela::film::FilterType::Gaussian,
@@ -517,6 +544,16 @@ fn finish_denoise(
 
 /// Checks the film options clap cannot (pass names).
 fn check_film_args(args: &RenderArgs) -> Result<(), String> {
+    for (name, v) in [
+        ("--clamp-direct", args.clamp_direct),
+        ("--clamp-indirect", args.clamp_indirect),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(format!(
+                "{name} {v}: the clamp must be a number >= 0 (0 = off)"
+            ));
+        }
+    }
     if !(args.filter_width.is_finite() && (0.01..=10.0).contains(&args.filter_width)) {
         return Err(format!(
             "--filter-width {}: the width must be between 0.01 and 10 pixels",

@@ -47,6 +47,8 @@ pub struct RenderOptions {
     pub time_limit: Option<f64>,
     /// How sample positions spread over and around each pixel.
     pub filter: crate::film::PixelFilter,
+    /// Per-kind bounce limits, transparent pass-throughs and clamping (path integrators).
+    pub light_paths: crate::integrator::light_paths::LightPaths,
 }
 
 impl Default for RenderOptions {
@@ -65,6 +67,7 @@ impl Default for RenderOptions {
             adaptive: None,
             time_limit: None,
             filter: Default::default(),
+            light_paths: Default::default(),
         }
     }
 }
@@ -383,8 +386,12 @@ struct Prepared {
 fn prepare(scene: &RenderScene, opts: &RenderOptions) -> Result<Prepared, RenderError> {
     validate(opts)?;
     Ok(Prepared {
-        integrator: integrator::by_name(&opts.integrator, opts.max_depth.max(1))
-            .ok_or_else(|| RenderError::Invalid("unknown integrator".into()))?,
+        integrator: integrator::by_name_with(
+            &opts.integrator,
+            opts.max_depth.max(1),
+            opts.light_paths,
+        )
+        .ok_or_else(|| RenderError::Invalid("unknown integrator".into()))?,
         camera: RayCamera::new(&scene.scene, opts.width, opts.height),
         region: opts.region.unwrap_or([0, 0, opts.width, opts.height]),
     })

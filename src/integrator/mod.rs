@@ -9,6 +9,7 @@ pub mod debug;
 pub mod direct_ems;
 pub mod direct_mats;
 pub mod direct_mis;
+pub mod light_paths;
 pub mod path;
 pub mod scaled;
 
@@ -38,6 +39,15 @@ pub const NAMES: [&str; 8] = [
 
 /// Builds the integrator called `name` with the given maximum path depth.
 pub fn by_name(name: &str, max_depth: u32) -> Option<Box<dyn Integrator>> {
+    by_name_with(name, max_depth, light_paths::LightPaths::default())
+}
+
+/// [`by_name`] with Cycles' light-path limits and clamps (used by the path integrators).
+pub fn by_name_with(
+    name: &str,
+    max_depth: u32,
+    paths: light_paths::LightPaths,
+) -> Option<Box<dyn Integrator>> {
     Some(match name {
         "direct_ems" => Box::new(direct_ems::DirectEms {
             max_depth,
@@ -54,8 +64,8 @@ pub fn by_name(name: &str, max_depth: u32) -> Option<Box<dyn Integrator>> {
         }),
         "direct_mats" => Box::new(direct_mats::DirectMats { max_depth }),
         "direct_mis" => Box::new(direct_mis::DirectMis { max_depth }),
-        "path_mats" => Box::new(path::PathMats { max_depth }),
-        "path_mis" => Box::new(path::PathMis { max_depth }),
+        "path_mats" => Box::new(path::PathMats { max_depth, paths }),
+        "path_mis" => Box::new(path::PathMis { max_depth, paths }),
         "normals" => Box::new(debug::Normals),
         "albedo" => Box::new(debug::Albedo),
         _ => return None,

@@ -2,9 +2,8 @@
 //! BSDF sampling at every vertex, power heuristic). Russian roulette from vertex 4 on, on the
 //! throughput's **maximum** component, survival probability capped at 0.95.
 
-use super::{
-    Integrator, MAX_TRANSPARENT, ShadingPoint, mis_weight, sample_emitter, spawn, trace_lit,
-};
+use super::light_paths::{BounceCount, LightPaths};
+use super::{Integrator, ShadingPoint, mis_weight, sample_emitter, spawn, trace_lit};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
@@ -14,10 +13,12 @@ const RR_DEPTH: u32 = 4;
 
 pub struct PathMats {
     pub max_depth: u32,
+    pub paths: LightPaths,
 }
 
 pub struct PathMis {
     pub max_depth: u32,
+    pub paths: LightPaths,
 }
 
 /// Russian roulette: returns false to terminate, else rescales `throughput`.
@@ -40,19 +41,21 @@ impl Integrator for PathMats {
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
         let mut transparent = 0;
+        let (mut counts, mut end) = (BounceCount::default(), self.max_depth);
         loop {
-            let last = depth >= self.max_depth;
+            let last = depth >= end;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
+            let direct = depth <= 2;
             if let Some((_, le, _)) = emitted {
-                l += throughput * le;
+                l += self.paths.clamp(throughput * le, direct);
             }
             if lights != Vec3::ZERO {
-                l += throughput * lights;
+                l += self.paths.clamp(throughput * lights, direct);
             }
             let Some(its) = hit else {
                 return l;
             };
-            if depth >= self.max_depth || !roulette(ctx, depth, &mut throughput) {
+            if depth >= end || !roulette(ctx, depth, &mut throughput) {
                 return l;
             }
             let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
@@ -62,7 +65,7 @@ impl Integrator for PathMats {
                 // Straight through a transparent closure: not a bounce (Cycles counts these
                 // separately, up to its default of 8).
                 transparent += 1;
-                if transparent > MAX_TRANSPARENT {
+                if transparent > self.paths.transparent {
                     return l;
                 }
                 throughput *= sp.weight;
@@ -73,6 +76,10 @@ impl Integrator for PathMats {
                 return l;
             };
             throughput *= w;
+            // `sample` left the new ray's Light Path bits in the context.
+            if counts.count(ctx.ray_flags, &self.paths) {
+                end = end.min(depth + 1);
+            }
             o = spawn(&its, wo);
             d = wo;
             depth += 1;
@@ -89,8 +96,9 @@ impl Integrator for PathMis {
         // Density of the BSDF sample that produced the current ray; infinite for camera rays
         // and delta samples (emitter sampling could not have produced them: MIS weight 1).
         let mut bsdf_pdf = f32::INFINITY;
+        let (mut counts, mut end) = (BounceCount::default(), self.max_depth);
         loop {
-            let last = depth >= self.max_depth;
+            let last = depth >= end;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, bsdf_pdf);
             if let Some((e, le, erec)) = emitted {
                 let w = if bsdf_pdf.is_infinite() {
@@ -98,15 +106,15 @@ impl Integrator for PathMis {
                 } else {
                     mis_weight(bsdf_pdf, scene.light_pdf(e, &erec))
                 };
-                l += throughput * le * w;
+                l += self.paths.clamp(throughput * le * w, depth <= 2);
             }
             if lights != Vec3::ZERO {
-                l += throughput * lights;
+                l += self.paths.clamp(throughput * lights, depth <= 2);
             }
             let Some(its) = hit else {
                 return l;
             };
-            if depth >= self.max_depth || !roulette(ctx, depth, &mut throughput) {
+            if depth >= end || !roulette(ctx, depth, &mut throughput) {
                 return l;
             }
             let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
@@ -116,7 +124,7 @@ impl Integrator for PathMis {
                 // Straight through a transparent closure: not a bounce (Cycles counts these
                 // separately, up to its default of 8).
                 transparent += 1;
-                if transparent > MAX_TRANSPARENT {
+                if transparent > self.paths.transparent {
                     return l;
                 }
                 throughput *= sp.weight;
@@ -124,7 +132,8 @@ impl Integrator for PathMis {
                 continue;
             }
             if !sp.bsdf_is_delta() {
-                l += throughput * sample_emitter(scene, ctx, &its, &sp, d, true);
+                let ls = throughput * sample_emitter(scene, ctx, &its, &sp, d, true);
+                l += self.paths.clamp(ls, depth == 1);
             }
             let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
                 return l;
@@ -135,6 +144,10 @@ impl Integrator for PathMis {
                 rec.pdf
             };
             throughput *= w;
+            // `sample` left the new ray's Light Path bits in the context.
+            if counts.count(ctx.ray_flags, &self.paths) {
+                end = end.min(depth + 1);
+            }
             o = spawn(&its, wo);
             d = wo;
             depth += 1;

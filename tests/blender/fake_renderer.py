@@ -50,7 +50,9 @@ def parse_args(argv):
         elif a in ("--integrator", "--spp", "--max-depth", "--width", "--height",
                    "--seed", "--threads", "--pipe-version", "--passes", "--adaptive-threshold",
                    "--adaptive-min-samples", "--time-limit", "--denoise-prefilter", "--filter",
-                   "--filter-width"):
+                   "--filter-width", "--diffuse-bounces", "--glossy-bounces",
+                   "--transmission-bounces", "--transparent-bounces", "--clamp-direct",
+                   "--clamp-indirect"):
             opts[a[2:].replace("-", "_")] = argv[i + 1]
             i += 2
         else:

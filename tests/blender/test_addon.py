@@ -98,6 +98,9 @@ def simple_scene(width=40, height=30, percentage=100, camera=True):
     scene.tesela.use_denoising = False  # the F12-equals-CLI tests compare raw renders
     scene.tesela.pixel_filter_type = "BOX"  # ... with the CLI's default filter
     scene.tesela.filter_width = 1.0
+    scene.tesela.diffuse_bounces = scene.tesela.glossy_bounces = 1024  # ... and light paths
+    scene.tesela.transmission_bounces = 1024
+    scene.tesela.sample_clamp_indirect = 0.0
 
     mesh = bpy.data.meshes.new("Plane")
     mesh.from_pydata([(-2, -2, 0), (2, -2, 0), (2, 2, 0), (-2, 2, 0)], [], [(0, 1, 2, 3)])
