@@ -321,7 +321,10 @@ fn render_reference(
     })
 }
 
-/// Seeds: every render of a study has its own, so all are independent.
+/// Seeds: each (rung, seed index) and each reference or sweep render has its own, so one
+/// integrator's renders are independent of each other and of the references. Integrators
+/// share the seed of a (rung, seed index): common random numbers (the same camera samples),
+/// which sharpen their comparison.
 fn measurement_seed(spp: u32, k: u32) -> u64 {
     ((spp as u64) << 20) | k as u64
 }
