@@ -223,7 +223,7 @@ struct StudyArgs {
     /// Skip the light-size sweep.
     #[arg(long)]
     no_sweep: bool,
-    /// The rung of the ladder shown in the image strips.
+    /// The rung of the ladder shown in the image strips (else the largest rung below it).
     #[arg(long, default_value_t = 16)]
     strip_spp: u32,
     /// Random numbers: independent (plain Monte Carlo, whose error falls as 1/N; the
@@ -288,6 +288,15 @@ fn run_study(args: &StudyArgs) -> ExitCode {
             "tesela: error: --width {} must be in 1..=4096",
             config.width
         );
+        return ExitCode::from(EXIT_USAGE);
+    }
+    if let Err(e) = config.check() {
+        eprintln!("tesela: error: {e}");
+        return ExitCode::from(EXIT_USAGE);
+    }
+    // Before minutes of rendering: a folder that cannot be made fails now.
+    if let Err(e) = std::fs::create_dir_all(&args.out) {
+        eprintln!("tesela: error: {}: cannot create: {e}", args.out.display());
         return ExitCode::from(EXIT_USAGE);
     }
     let bar = if args.quiet {

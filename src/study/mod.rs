@@ -102,9 +102,10 @@ pub struct Summary {
     /// Mean over the reference's mean, pooled over every render (inverse-variance weights),
     /// with its standard error (that of the reference included).
     pub mean_ratio: Estimate,
-    /// `(mean_ratio − 1) / se`.
+    /// `(mean_ratio − 1) / se`; NaN (`null` in JSON) when the standard error is unknown
+    /// (one seed per rung).
     pub bias_z: f64,
-    /// `|bias_z| <= 3`.
+    /// `|bias_z| <= 3` (false when `bias_z` is unknown).
     pub unbiased: bool,
     /// Pooled mean ratios inside the named regions.
     pub region_ratios: BTreeMap<String, Estimate>,

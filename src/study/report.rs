@@ -130,10 +130,16 @@ fn unbiased(study: &Study) -> Claim {
             s.scene, s.integrator, s.mean_ratio.value, s.mean_ratio.se, s.bias_z
         ));
     }
+    // Without a standard error (one seed per rung) there is no verdict.
+    let measured = study
+        .summaries
+        .iter()
+        .filter(|s| !expected_biased(&s.integrator))
+        .all(|s| !s.bias_z.is_nan());
     Claim {
         id: "unbiased".into(),
         statement,
-        holds: Some(holds && !parts.is_empty()),
+        holds: (measured && !parts.is_empty()).then_some(holds),
         evidence: parts.join("; "),
     }
 }

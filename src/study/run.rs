@@ -109,7 +109,8 @@ pub struct StudyConfig {
     /// Worker threads per render (0 = one per core).
     pub threads: usize,
     pub sweep: Option<Sweep>,
-    /// The rung whose first-seed images make the image strips.
+    /// The rung whose first-seed images make the image strips (the largest rung at or below
+    /// it when it is not on the ladder).
     pub strip_spp: u32,
     /// Independent samples (plain Monte Carlo, as the assignment's sampler) or Tesela's
     /// stratified Sobol samples.
@@ -151,7 +152,8 @@ impl StudyConfig {
         }
     }
 
-    fn check(&self) -> Result<(), String> {
+    /// Refuses settings that cannot be measured (empty ladder, unknown integrator, ...).
+    pub fn check(&self) -> Result<(), String> {
         if self.scenes.is_empty() {
             return Err("the study has no scenes".into());
         }
@@ -320,7 +322,10 @@ fn render_reference(
     })
 }
 
-/// Seeds: every render of a study has its own, so all are independent.
+/// Seeds: each (rung, seed index) and each reference or sweep render has its own, so one
+/// integrator's renders are independent of each other and of the references. Integrators
+/// share the seed of a (rung, seed index): common random numbers (the same camera samples),
+/// which sharpen their comparison.
 fn measurement_seed(spp: u32, k: u32) -> u64 {
     ((spp as u64) << 20) | k as u64
 }
@@ -393,6 +398,14 @@ pub fn run(
 ) -> Result<Outcome, String> {
     config.check()?;
     let start = Instant::now();
+    // The strips show the largest rung at or below the one asked for (the first rung if none).
+    let strip_spp = config
+        .spp
+        .iter()
+        .copied()
+        .filter(|&n| n <= config.strip_spp)
+        .max()
+        .unwrap_or(config.spp[0]);
     bar.set_length(total_samples(config));
     let mut references = Vec::new();
     let mut measurements = Vec::new();
@@ -478,7 +491,7 @@ pub fn run(
                     });
                     err_sum += rel_mse;
                     sec_sum += seconds;
-                    if spp == config.strip_spp && k == 0 {
+                    if spp == strip_spp && k == 0 {
                         renders.push(StripRender {
                             integrator: integrator.clone(),
                             image: img,
@@ -494,7 +507,12 @@ pub fn run(
                 });
             }
             let mean_ratio = metrics::ratio(metrics::pooled_mean(&pooled_parts), reference.mean);
-            let bias_z = (mean_ratio.value - 1.0) / mean_ratio.se;
+            // One seed per rung gives no spread, hence no standard error: no verdict on bias.
+            let bias_z = if mean_ratio.se.is_finite() {
+                (mean_ratio.value - 1.0) / mean_ratio.se
+            } else {
+                f64::NAN
+            };
             let fit = |x: fn(&SppSummary) -> f64| {
                 metrics::log_log_fit(
                     &per_spp
@@ -524,7 +542,7 @@ pub fn run(
             scene: s.name.clone(),
             width: size.0,
             height: size.1,
-            spp: config.strip_spp,
+            spp: strip_spp,
             renders,
         });
     }
@@ -581,7 +599,7 @@ pub fn run(
                 .sweep
                 .as_ref()
                 .map_or(Vec::new(), |s| s.area_scales.clone()),
-            strip_spp: config.strip_spp,
+            strip_spp,
             sampler: sampler_name(config.sampling).into(),
             rel_mse_epsilon: metrics::REL_MSE_EPSILON,
             seconds: 0.0,
