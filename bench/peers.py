@@ -665,6 +665,93 @@ def addon_bench(args):
     return text
 
 
+def _render_result_image():
+    import bpy
+    path = Path(tempfile.mkdtemp(prefix="tesela-clean-")) / "r.exr"
+    st = bpy.context.scene.render.image_settings
+    if hasattr(st, "media_type"):
+        st.media_type = "IMAGE"
+    st.file_format, st.color_depth = "OPEN_EXR", "32"
+    bpy.data.images["Render Result"].save_render(str(path))
+    img = read_exr(path)
+    shutil.rmtree(path.parent, ignore_errors=True)
+    return img
+
+
+CLEAN_SCENES = {
+    "cornell": ("scenes", "cornell_box"),
+    "hdri_product": ("test_world_cycles", "hdri_world"),
+}
+
+
+def clean_bench(args):
+    """Time to a clean image: each renderer with its artist-facing defaults for a final render
+    (noise threshold 0.01, OIDN with albedo/normal guides; Cycles 4096 max samples, Tesela's
+    add-on 1024), wall time of bpy.ops.render.render and relMSE against the renderer's own
+    converged reference (no denoising, `--clean-ref-spp` samples). Tesela is also run at other
+    noise thresholds, so its time at Cycles' error can be read off."""
+    import bpy
+    import importlib
+    tests = REPO / "tests" / "blender"
+    for path in (REPO, tests):
+        sys.path.insert(0, str(path))
+    sys.modules.pop("scenes", None)
+    import blender_addon
+    import scenes as bs
+    from blender_addon import engine as tesela_engine
+    if not tesela_engine.TeselaRenderEngine.is_registered:
+        blender_addon.register()
+    os.environ["TESELA_BINARY"] = str(args.tesela)
+    size = args.size or (48 if args.quick else 128)
+    ref_spp = 64 if args.quick else args.clean_ref_spp
+    bounces = 3
+    lines = [f"#### Time to a clean image: {size}x{size}, Cycles max bounces {bounces} / Tesela "
+             f"path_mis depth {bounces + 2}, {args.threads} threads; relMSE against each "
+             f"renderer's own {ref_spp} spp reference", "",
+             "| scene | peer | settings | wall s | relMSE | mean RGB |", "| --- | --- | --- | --- | --- | --- |"]
+    for name, (module, builder) in CLEAN_SCENES.items():
+        bs.clear_scene()
+        getattr(importlib.import_module(module), builder)()
+        sc = bpy.context.scene
+        bs.configure_cycles(sc, size, size, ref_spp, bounces, seed=1, threads=args.threads)
+        t = sc.tesela
+        t.integrator, t.max_depth, t.threads = "path_mis", bounces + 2, args.threads
+        t.diffuse_bounces = t.glossy_bounces = t.transmission_bounces = 1024
+        t.sample_clamp_indirect = 0.0
+        t.pixel_filter_type, t.filter_width = "BOX", 1.0
+        # The references: plain sampling, no denoiser.
+        t.use_adaptive_sampling = t.use_denoising = False
+        _addon_render("CYCLES", ref_spp, 7)
+        ref = {"cycles": _render_result_image()}
+        _addon_render("TESELA", ref_spp, 7)
+        ref["tesela"] = _render_result_image()
+        c = sc.cycles
+        c.use_adaptive_sampling, c.adaptive_threshold, c.adaptive_min_samples = True, 0.01, 0
+        c.use_denoising = True
+        if hasattr(c, "denoiser"):
+            c.denoiser = "OPENIMAGEDENOISE"
+        if hasattr(c, "denoising_input_passes"):
+            c.denoising_input_passes = "RGB_ALBEDO_NORMAL"
+        runs = [("cycles", "CYCLES", "defaults: threshold 0.01, OIDN, 4096 max", 4096, None)]
+        for thr in (0.01, 0.02, 0.05):
+            runs.append(("tesela", "TESELA", f"threshold {thr}, OIDN, 1024 max", 1024, thr))
+        for peer, engine, label, spp, thr in runs:
+            if thr is not None:
+                t.use_adaptive_sampling, t.adaptive_threshold, t.use_denoising = True, thr, True
+            walls, errs = [], []
+            for r in range(args.repeats or (1 if args.quick else 3)):
+                walls.append(_addon_render(engine, spp, 11 + r))
+                img = _render_result_image()
+                errs.append(rel_mse(img, ref[peer]))
+            m = ", ".join(f"{v:.4f}" for v in img.reshape(-1, 3).mean(axis=0))
+            lines.append(f"| {name} | {peer} | {label} | {statistics.median(walls):.2f} | "
+                         f"{statistics.median(errs):.2e} | {m} |")
+            log(lines[-1])
+    text = "\n".join(lines)
+    log("\n" + text)
+    return text
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="tiny sizes: a smoke run")
@@ -692,16 +779,20 @@ def main():
                     help="only the Blender scenes through the add-on (Tesela vs Cycles, same spp)")
     ap.add_argument("--addon-scenes", default=",".join(ADDON_SCENES))
     ap.add_argument("--addon-spp", type=int, default=64)
+    ap.add_argument("--clean", action="store_true",
+                    help="time to a clean image with each renderer's defaults (adaptive + OIDN)")
+    ap.add_argument("--clean-ref-spp", type=int, default=2048)
     args = ap.parse_args()
     if args.merge:
         return merge(args)
-    if args.addon:
+    if args.addon or args.clean:
         import bpy  # noqa: F401
-        text = addon_bench(args)
+        text = clean_bench(args) if args.clean else addon_bench(args)
         if args.out:
             Path(args.out).mkdir(parents=True, exist_ok=True)
             stamp = _dt.datetime.now(_dt.timezone.utc).strftime("%Y%m%d-%H%M")
-            (Path(args.out) / f"addon-{stamp}.md").write_text(text + "\n")
+            kind = "clean" if args.clean else "addon"
+            (Path(args.out) / f"{kind}-{stamp}.md").write_text(text + "\n")
         return None
     q = args.quick
     args.repeats = args.repeats or (2 if q else 5)

@@ -183,13 +183,22 @@ class RenderSession:
         return code
 
 
-def renderer_args(binary, gltf, settings, width, height, region, pass_names=()):
+def render_seed(settings, frame):
+    """The seed of a frame: Cycles' use_animated_seed adds the frame number (a new noise
+    pattern every frame of an animation)."""
+    seed = int(settings.seed)
+    if getattr(settings, "use_animated_seed", False):
+        seed += int(frame)
+    return max(seed, 0)
+
+
+def renderer_args(binary, gltf, settings, width, height, region, pass_names=(), frame=0):
     args = [binary, "render", gltf, "--pipe", "--pipe-version", str(protocol.PROTOCOL_VERSION),
             "--integrator", settings.integrator,
             "--spp", str(settings.samples),
             "--max-depth", str(settings.max_depth),
             "--width", str(width), "--height", str(height),
-            "--seed", str(settings.seed)]
+            "--seed", str(render_seed(settings, frame))]
     if settings.threads > 0:
         args += ["--threads", str(settings.threads)]
     if region is not None:
@@ -383,7 +392,8 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
             print("Tesela: " + message)
             self.report({"WARNING"}, "Tesela: " + message)
 
-        args = renderer_args(binary, gltf, settings, width, height, region, pass_names)
+        args = renderer_args(binary, gltf, settings, width, height, region, pass_names,
+                             frame=scene.frame_current)
         try:
             session.start(args)
         except OSError as exc:

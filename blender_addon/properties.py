@@ -24,6 +24,9 @@ class TeselaSceneSettings(bpy.types.PropertyGroup):
     max_depth: IntProperty(name="Max Depth", default=14, min=1, max=1024,
                            description="Maximum number of path vertices (Cycles' max bounces + 2)")
     seed: IntProperty(name="Seed", default=0, min=0, description="Random seed")
+    use_animated_seed: BoolProperty(
+        name="Animated Seed", default=False,
+        description="Use a different seed for each frame (the seed plus the frame number)")
     threads: IntProperty(name="Threads", default=0, min=0, max=1024,
                          description="Render threads (0: all cores)")
     diffuse_bounces: IntProperty(

@@ -60,7 +60,9 @@ class TESELA_PT_render(bpy.types.Panel):
         sub.active = s.use_adaptive_sampling
         sub.prop(s, "adaptive_min_samples")
         col.prop(s, "time_limit")
-        col.prop(s, "seed")
+        row = col.row(align=True)
+        row.prop(s, "seed")
+        row.prop(s, "use_animated_seed", text="", icon="TIME")
         col = layout.column(heading="Denoise")
         col.prop(s, "use_denoising")
         sub = col.column()

@@ -959,3 +959,12 @@ def test_progress_lines_for_farms_and_time_left():
     assert len(printed) == 21 and printed[0] == 0.0 and printed[-1] == 1.0
     assert tesela_engine.format_time_left(30.0, 0.25) == "Time 00:30 | Remaining 01:30"
     assert tesela_engine.format_time_left(5.0, 1.0) == "Time 00:05"
+
+
+def test_animated_seed_adds_the_frame():
+    class S:
+        seed, use_animated_seed = 7, False
+    assert tesela_engine.render_seed(S, 12) == 7
+    S.use_animated_seed = True
+    assert tesela_engine.render_seed(S, 12) == 19
+    assert tesela_engine.render_seed(S, -20) == 0
