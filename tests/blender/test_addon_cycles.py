@@ -153,13 +153,8 @@ CASES = [
     # Cycles interpolates 8-bit sRGB textures in sRGB and decodes afterwards
     # (NODE_IMAGE_COMPRESS_AS_SRGB); so does Tesela, as glTF images are 8-bit files.
     ("texture_srgb8_linear-direct_mis", textured_plane, 0, "direct_mis", 64),
-    # A float image is filtered in linear space by Cycles, but reaches Tesela as an 8-bit sRGB
-    # PNG (glTF has no float images), which Tesela filters in sRGB like any 8-bit image.
-    pytest.param(("texture_float-direct_mis", lambda: textured_plane(float_image=True), 0,
-                  "direct_mis", 64),
-                 marks=pytest.mark.xfail(reason="float images travel as 8-bit sRGB PNGs and are "
-                                                "filtered in sRGB; Cycles filters floats linearly",
-                                         strict=False)),
+    # A float image travels unclipped in TESELA_images and is filtered linearly, as Cycles does.
+    ("texture_float-direct_mis", lambda: textured_plane(float_image=True), 0, "direct_mis", 64),
     ("emissive_sphere-direct_mis", lambda: scenes.emissive_sphere(), 0, "direct_mis", 256),
 ]
 
