@@ -458,22 +458,40 @@ impl RenderScene {
             sum += le * tr * self.forward_weight(e, &rec, bsdf_pdf);
         }
         if tmax.is_infinite() {
-            for &e in &self.suns {
-                if !self.ray_sees(e, depth, flags) {
-                    continue;
-                }
-                let rec = EmitterQueryRecord::towards(o, d);
-                let le = self.emitters[e as usize].eval(&self.scene, &rec);
-                if le == Vec3::ZERO {
-                    continue;
-                }
-                let tr = if occlusion {
-                    self.segment_transmittance(ctx, o, d, f32::INFINITY)
-                } else {
-                    Vec3::ONE
-                };
-                sum += le * tr * self.forward_weight(e, &rec, bsdf_pdf);
+            sum += self.suns_on_ray(ctx, o, d, depth, bsdf_pdf, occlusion);
+        }
+        sum
+    }
+
+    /// The radiance of the suns a ray along `d` leaves the scene towards (see
+    /// [`RenderScene::lights_on_ray`]); for a camera ray that escapes past the far clip, as
+    /// the world, the suns still show.
+    pub fn suns_on_ray(
+        &self,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        depth: u32,
+        bsdf_pdf: f32,
+        occlusion: bool,
+    ) -> Vec3 {
+        let flags = ctx.ray_flags;
+        let mut sum = Vec3::ZERO;
+        for &e in &self.suns {
+            if !self.ray_sees(e, depth, flags) {
+                continue;
             }
+            let rec = EmitterQueryRecord::towards(o, d);
+            let le = self.emitters[e as usize].eval(&self.scene, &rec);
+            if le == Vec3::ZERO {
+                continue;
+            }
+            let tr = if occlusion {
+                self.segment_transmittance(ctx, o, d, f32::INFINITY)
+            } else {
+                Vec3::ONE
+            };
+            sum += le * tr * self.forward_weight(e, &rec, bsdf_pdf);
         }
         sum
     }
@@ -733,7 +751,7 @@ impl RenderScene {
             return self.intersect(ctx, o, d);
         }
         ctx.cast(o, d, tmax, RayKind::Closest);
-        let hit = self.accel.intersect_with(&mut ctx.trav, o, d, 0.0, tmax)?;
+        let hit = self.closest(ctx, o, d, tmax)?;
         Some(self.intersection(&hit, d))
     }
 

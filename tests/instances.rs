@@ -135,6 +135,18 @@ fn instances_render_as_their_baked_meshes() {
     }
 }
 
+/// Camera rays that end at a far clip still meet instances (the clipped query goes through
+/// the top level too): with a far clip beyond the box, the image is the unclipped one.
+#[test]
+fn clipped_camera_rays_see_instances() {
+    let mut clipped = instanced();
+    let cam = clipped.camera.as_mut().expect("the box has a camera");
+    cam.clip_end = 1000.0;
+    let a = render_scene(instanced(), "normals");
+    let b = render_scene(clipped, "normals");
+    assert!(a == b, "a far clip beyond the scene changed the image");
+}
+
 #[test]
 fn an_emissive_instance_lights_as_its_area_under_scale() {
     // Only the glowing spheres light the box: the light they give depends on their world area.

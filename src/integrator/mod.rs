@@ -444,7 +444,12 @@ pub fn trace_lit(
             f32::INFINITY
         };
         let tmax = hit.as_ref().map_or(end, |its| (its.p - o).length());
-        scene.lights_on_ray(ctx, o, d, tmax, depth, bsdf_pdf, false)
+        let mut l = scene.lights_on_ray(ctx, o, d, tmax, depth, bsdf_pdf, false);
+        if hit.is_none() && tmax.is_finite() {
+            // A camera ray that escapes past the far clip still sees the suns, as the world.
+            l += scene.suns_on_ray(ctx, o, d, depth, bsdf_pdf, false);
+        }
+        l
     };
     (hit, emitted, lights)
 }
