@@ -73,14 +73,29 @@ impl DataContext<'_> {
                 emission += tr * scene.lights_on_ray(ctx, p, d, tmax, 1, f32::INFINITY, false);
             }
             let Some(its) = hit else {
-                if let Some(at) = set.offset(Pass::Environment) {
-                    let le = scene.world_radiance(d, o);
-                    put(acc, at, &(tr * le).to_array(), false);
+                let env = set.offset(Pass::Environment);
+                // The denoiser's albedo is the world's radiance where the camera sees it
+                // (Cycles adds emission and background to the feature before any surface
+                // wrote it), so a sky is not a black hole in its guide.
+                let albedo = set.offset(Pass::DenoisingAlbedo).filter(|_| !data_done);
+                if env.is_some() || albedo.is_some() {
+                    let le = tr * scene.world_radiance(d, o);
+                    for at in env.into_iter().chain(albedo) {
+                        put(acc, at, &le.to_array(), false);
+                    }
                 }
                 break;
             };
-            if want_emission && let Some((_, le, _)) = scene.emitted(&its, o) {
-                emission += tr * le;
+            let want_albedo = !data_done && set.contains(Pass::DenoisingAlbedo);
+            if (want_emission || want_albedo)
+                && let Some((_, le, _)) = scene.emitted(&its, o)
+            {
+                if want_emission {
+                    emission += tr * le;
+                }
+                if let Some(at) = set.offset(Pass::DenoisingAlbedo).filter(|_| want_albedo) {
+                    put(acc, at, &(tr * le).to_array(), false);
+                }
             }
             let program = &scene.programs[its.material as usize];
             let backfacing = its.ng.dot(d) > 0.0;
