@@ -216,23 +216,45 @@ impl Environment {
         let Some([w, h, ss]) = res else {
             return env;
         };
-        let mut lum = vec![0.0f32; w * h];
-        lum.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
+        // Per cell: the sampling weight, and the radiance at its centre (for the power).
+        let mut cells = vec![(0.0f32, 0.0f32); w * h];
+        cells.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
             for (i, out) in row.iter_mut().enumerate() {
+                let lum_at = |u: f32, t: f32| {
+                    let l = luminance(env.light_radiance(scene, cell_direction(u, t)));
+                    if l.is_finite() && l > 0.0 { l } else { 0.0 }
+                };
+                if ss == 1 {
+                    // A map cell is one texel, but a filtered lookup spreads a bright texel
+                    // half a texel into its neighbours: the cell takes the largest radiance
+                    // it holds (bilinear is monotone between texel centres, so the corners,
+                    // edge midpoints and centre find it), or a small sun's rim would be
+                    // sampled at the sky's density.
+                    let mut m = 0.0f32;
+                    for a in 0..3 {
+                        for b in 0..3 {
+                            let u = (i as f32 + b as f32 * 0.5) / w as f32;
+                            let t = (j as f32 + a as f32 * 0.5) / h as f32;
+                            m = m.max(lum_at(u.min(1.0), t.min(1.0)));
+                        }
+                    }
+                    let centre = lum_at((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32);
+                    *out = (m, centre);
+                    continue;
+                }
                 let mut sum = 0.0f64;
                 for a in 0..ss {
                     for b in 0..ss {
                         let u = (i as f32 + (b as f32 + 0.5) / ss as f32) / w as f32;
                         let t = (j as f32 + (a as f32 + 0.5) / ss as f32) / h as f32;
-                        let l = luminance(env.light_radiance(scene, cell_direction(u, t)));
-                        if l.is_finite() && l > 0.0 {
-                            sum += l as f64;
-                        }
+                        sum += lum_at(u, t) as f64;
                     }
                 }
-                *out = (sum / (ss * ss) as f64) as f32;
+                let mean = (sum / (ss * ss) as f64) as f32;
+                *out = (mean, mean);
             }
         });
+        let lum: Vec<f32> = cells.iter().map(|c| c.0).collect();
         let first = lum[0];
         if lum.iter().all(|&l| l == first) {
             env.integral = if first.is_finite() {
@@ -245,12 +267,12 @@ impl Environment {
         let mut integral = 0.0f64;
         let func: Vec<f32> = lum
             .iter()
+            .zip(&cells)
             .enumerate()
-            .map(|(k, &l)| {
-                let t = ((k / w) as f32 + 0.5) / h as f32;
-                let f = l * (PI * t).sin();
-                integral += f as f64;
-                f
+            .map(|(k, (&l, &(_, centre)))| {
+                let sin_t = (PI * ((k / w) as f32 + 0.5) / h as f32).sin();
+                integral += (centre * sin_t) as f64;
+                l * sin_t
             })
             .collect();
         env.integral =

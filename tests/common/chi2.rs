@@ -387,6 +387,23 @@ pub fn check_directions(
     pdf: &dyn Fn(Vec3) -> f64,
     alpha: f64,
 ) -> DirCheck {
+    check_directions_with(name, grid, n, seed, sample, pdf, alpha, false)
+}
+
+/// [`check_directions`] with every cell's expected count from the dense 128×128 midpoint
+/// rule (`dense`), for piecewise-constant densities (an environment map) whose many sharp
+/// steps the adaptive cubature can misjudge.
+#[allow(clippy::too_many_arguments, dead_code)]
+pub fn check_directions_with(
+    name: &str,
+    grid: &DirGrid,
+    n: usize,
+    seed: u64,
+    sample: &mut dyn FnMut(&mut Sampler) -> Option<Vec3>,
+    pdf: &dyn Fn(Vec3) -> f64,
+    alpha: f64,
+    dense: bool,
+) -> DirCheck {
     let mut rng = Sampler::new(seed, 0, 0);
     let mut obs = vec![0.0; grid.cells() + 1];
     for _ in 0..n {
@@ -401,7 +418,7 @@ pub fn check_directions(
     // (e.g. a corner just above the horizon). Before calling its samples an error, re-integrate
     // such cells with a dense 128×128 midpoint rule.
     for c in 0..grid.cells() {
-        if exp[c] <= 1e-9 && obs[c] > 0.0 {
+        if dense || (exp[c] <= 1e-9 && obs[c] > 0.0) {
             exp[c] = n as f64 * grid.dense_cell_integral(c, pdf, 128);
         }
     }
