@@ -590,16 +590,7 @@ def _addon_render(engine, spp, seed):
 
 
 def _render_result_mean():
-    import bpy
-    img = bpy.data.images["Render Result"]
-    # The Render Result has no pixels in bpy until viewed: read them through a saved EXR.
-    path = Path(tempfile.mkdtemp(prefix="tesela-addon-")) / "r.exr"
-    st = bpy.context.scene.render.image_settings
-    if hasattr(st, "media_type"):
-        st.media_type = "IMAGE"
-    st.file_format, st.color_depth = "OPEN_EXR", "32"
-    img.save_render(str(path))
-    return read_exr(path).reshape(-1, 3).mean(axis=0)
+    return _render_result_image().reshape(-1, 3).mean(axis=0)
 
 
 def addon_bench(args):
@@ -636,6 +627,7 @@ def addon_bench(args):
         sc = bpy.context.scene
         bs.configure_cycles(sc, size, size, spp, bounces, seed=1, threads=args.threads)
         t = sc.tesela
+        bs.tesela_like_cycles(t)  # the same spp as Cycles: no noise threshold, no denoiser
         t.integrator, t.max_depth, t.threads = "path_mis", bounces + 2, args.threads
         _addon_render("TESELA", 1, 0)  # warm-up: caches, page faults
         _addon_render("CYCLES", 1, 0)
@@ -716,11 +708,8 @@ def clean_bench(args):
         bs.configure_cycles(sc, size, size, ref_spp, bounces, seed=1, threads=args.threads)
         t = sc.tesela
         t.integrator, t.max_depth, t.threads = "path_mis", bounces + 2, args.threads
-        t.diffuse_bounces = t.glossy_bounces = t.transmission_bounces = 1024
-        t.sample_clamp_indirect = 0.0
-        t.pixel_filter_type, t.filter_width = "BOX", 1.0
         # The references: plain sampling, no denoiser.
-        t.use_adaptive_sampling = t.use_denoising = False
+        bs.tesela_like_cycles(t)
         _addon_render("CYCLES", ref_spp, 7)
         ref = {"cycles": _render_result_image()}
         _addon_render("TESELA", ref_spp, 7)

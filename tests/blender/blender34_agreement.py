@@ -63,11 +63,7 @@ scenes.configure_cycles(scene, size, size, spp, bounces, seed=7)
 scenes.render_cycles(os.path.join(out_dir, "cycles.exr"))
 scene.render.engine = "TESELA"
 t = scene.tesela
-t.use_adaptive_sampling = t.use_denoising = False  # fixed spp, as the reference
-t.pixel_filter_type, t.filter_width = "BOX", 1.0  # configure_cycles' filter
-# configure_cycles' light paths: every kind up to the total, no clamping
-t.diffuse_bounces = t.glossy_bounces = t.transmission_bounces = 1024
-t.sample_clamp_indirect = 0.0
+scenes.tesela_like_cycles(t)
 t.integrator, t.samples, t.max_depth, t.seed = integrator, spp, bounces + 2, 1
 bpy.ops.render.render(write_still=False)
 bpy.data.images["Render Result"].save_render(os.path.join(out_dir, "tesela.exr"))

@@ -65,7 +65,7 @@ def checker_scene():
 def tesela(scene, kind, width):
     scene.render.engine = "TESELA"
     t = scene.tesela
-    t.use_adaptive_sampling = t.use_denoising = False
+    scenes.tesela_like_cycles(t)
     t.pixel_filter_type, t.filter_width = kind, width
     t.integrator, t.samples, t.max_depth, t.seed = "direct_mis", SPP, 1, 1
     assert bpy.ops.render.render() == {"FINISHED"}

@@ -107,8 +107,7 @@ def test_scatter_agrees_with_cycles(addon, tesela_bin, tmp_path, monkeypatch):
     ref = imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
     scene.render.engine = "TESELA"
     t = scene.tesela
-    t.use_adaptive_sampling = t.use_denoising = False  # fixed spp, as the reference
-    t.pixel_filter_type, t.filter_width = "BOX", 1.0  # configure_cycles' filter
+    scenes.tesela_like_cycles(t)
     t.integrator, t.samples, t.max_depth, t.seed = "direct_mis", spp, 2, 1
     t.threads = int(os.environ.get("TESELA_TEST_THREADS", "0"))
     assert bpy.ops.render.render() == {"FINISHED"}

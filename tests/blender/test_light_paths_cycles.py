@@ -49,10 +49,7 @@ CASES = [
 def render_tesela(scene, settings, spp, tmp_path):
     scene.render.engine = "TESELA"
     t = scene.tesela
-    t.use_adaptive_sampling = t.use_denoising = False
-    t.pixel_filter_type, t.filter_width = "BOX", 1.0
-    t.diffuse_bounces = t.glossy_bounces = t.transmission_bounces = 1024
-    t.sample_clamp_direct = t.sample_clamp_indirect = 0.0
+    scenes.tesela_like_cycles(t)
     for k, v in settings.items():
         setattr(t, k, v)
     t.integrator, t.samples, t.max_depth, t.seed = "path_mis", spp, BOUNCES + 2, 1

@@ -216,11 +216,7 @@ def test_light_parameters_agree_with_cycles(addon, tesela_bin, tmp_path, monkeyp
 
     scene.render.engine = "TESELA"
     t = scene.tesela
-    t.use_adaptive_sampling = t.use_denoising = False  # fixed spp, as the reference
-    t.pixel_filter_type, t.filter_width = "BOX", 1.0  # configure_cycles' filter
-    # configure_cycles' light paths: every kind up to the total, no clamping
-    t.diffuse_bounces = t.glossy_bounces = t.transmission_bounces = 1024
-    t.sample_clamp_indirect = 0.0
+    scenes.tesela_like_cycles(t)
     t.integrator, t.samples, t.max_depth, t.seed = integrator, spp, bounces + 2, 1
     t.threads = int(os.environ.get("TESELA_TEST_THREADS", "0"))
     assert bpy.ops.render.render() == {"FINISHED"}

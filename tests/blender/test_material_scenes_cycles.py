@@ -568,11 +568,7 @@ def render_tesela(tmp_path, bounces, spp):
     scenes.configure_cycles(scene, SIZE, SIZE, 1, bounces, seed=7)  # resolution etc.
     scene.render.engine = "TESELA"
     t = scene.tesela
-    t.use_adaptive_sampling = t.use_denoising = False  # fixed spp, as the reference
-    t.pixel_filter_type, t.filter_width = "BOX", 1.0  # configure_cycles' filter
-    # configure_cycles' light paths: every kind up to the total, no clamping
-    t.diffuse_bounces = t.glossy_bounces = t.transmission_bounces = 1024
-    t.sample_clamp_indirect = 0.0
+    scenes.tesela_like_cycles(t)
     t.integrator, t.samples, t.max_depth, t.seed = "path_mis", spp, bounces + 2, 1
     t.threads = int(os.environ.get("TESELA_TEST_THREADS", "0"))
     assert bpy.ops.render.render() == {"FINISHED"}

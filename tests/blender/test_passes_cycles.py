@@ -125,11 +125,7 @@ def renders(addon, tesela_bin, tmp_path_factory):
     ref = render_multilayer(tmp / "cycles.exr")
     scene.render.engine = "TESELA"
     t = scene.tesela
-    t.use_adaptive_sampling = t.use_denoising = False
-    t.pixel_filter_type, t.filter_width = "BOX", 1.0
-    # configure_cycles' light paths: every kind up to the total, no clamping
-    t.diffuse_bounces = t.glossy_bounces = t.transmission_bounces = 1024
-    t.sample_clamp_indirect = 0.0
+    scenes.tesela_like_cycles(t)
     t.integrator, t.samples, t.max_depth, t.seed = "direct_mis", SPP * 4, 2, 1
     got = render_multilayer(tmp / "tesela.exr")
     # The same render without passes: Combined must not change.
