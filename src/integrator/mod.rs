@@ -179,11 +179,12 @@ impl ShadingPoint {
             _ => None,
         };
         let smooth = (closure.normal != Vec3::ZERO).then(|| {
-            if its.ns.dot(-d) < 0.0 {
-                -its.ns
-            } else {
+            let ns = if closure.surface_normal == Vec3::ZERO {
                 its.ns
-            }
+            } else {
+                closure.surface_normal
+            };
+            if ns.dot(-d) < 0.0 { -ns } else { ns }
         });
         Some(ShadingPoint {
             smooth,

@@ -251,6 +251,51 @@ def noise_bump():
     _floor_stage(mat, sun_dir=(-1.0, 0.4, -0.35), sun=5.0, world_strength=0.05)
 
 
+def _displacement_output(mat, nt, out, disp_node):
+    nt.links.new(disp_node.outputs["Displacement"], out.inputs["Displacement"])
+    for owner in (mat, getattr(mat, "cycles", None)):
+        if owner is not None and hasattr(owner, "displacement_method"):
+            owner.displacement_method = "BUMP"
+            break
+
+
+def displacement_bump():
+    """Noise -> Displacement node (object space, scale 0.15) -> the material output's
+    Displacement, method Bump Only (Blender's default): the displaced normal shades a rough
+    Principled floor under a low sun; a Geometry Normal tints the base colour, so the surface
+    graph must see the displaced N too."""
+    mat, nt, out = node_material("Displaced")
+    tc = node(nt, "ShaderNodeTexCoord")
+    noise = node(nt, "ShaderNodeTexNoise", Vector=tc.outputs["Object"], Scale=3.0, Detail=2.0)
+    disp = node(nt, "ShaderNodeDisplacement", Height=noise.outputs["Fac"], Midlevel=0.5,
+                Scale=0.15)
+    geo = node(nt, "ShaderNodeNewGeometry")
+    tint = node(nt, "ShaderNodeMix", {"data_type": "RGBA"}, Factor=0.5,
+                A=(0.6, 0.5, 0.4, 1.0), B=geo.outputs["Normal"])
+    principled(nt, out, Base_Color=tint.outputs["Result"], Roughness=0.5)
+    _displacement_output(mat, nt, out, disp)
+    _floor_stage(mat, sun_dir=(-1.0, 0.4, -0.35), sun=5.0, world_strength=0.05)
+
+
+def vector_displacement_ball(vector=True):
+    """A Wave texture's colour as a world-space Vector Displacement of a ball (only its normal
+    component bumps; `vector` False: its Fac through an object-space Displacement node),
+    Diffuse BSDF, sun and world. Cycles' diffuse sees the displaced normal as the surface's
+    own: no bump shadowing."""
+    mat, nt, out = node_material("VecDisplaced")
+    tc = node(nt, "ShaderNodeTexCoord")
+    wave = node(nt, "ShaderNodeTexWave", Vector=tc.outputs["Object"], Scale=4.0, Distortion=2.0)
+    if vector:
+        disp = node(nt, "ShaderNodeVectorDisplacement", {"space": "WORLD"},
+                    Vector=wave.outputs["Color"], Midlevel=0.5, Scale=0.08)
+    else:
+        disp = node(nt, "ShaderNodeDisplacement", Height=wave.outputs["Fac"], Midlevel=0.5,
+                    Scale=0.08)
+    surface(nt, out, node(nt, "ShaderNodeBsdfDiffuse", Color=(0.7, 0.7, 0.7, 1.0)).outputs[0])
+    _displacement_output(mat, nt, out, disp)
+    _sphere_stage(mat)
+
+
 def mapping_image():
     """UV -> Mapping (scale (2, 3), rotation 30 degrees about Z, a location offset) -> Image
     Texture -> Diffuse colour."""
@@ -475,6 +520,9 @@ CASES = [
     # normals that turn away from the viewer all show here.
     ("normal_map_grazing_sun", normal_map, 0, 128, 512),
     ("noise_bump", noise_bump, 0, 128, 512),
+    ("displacement_bump_noise", displacement_bump, 0, 128, 512),
+    ("vector_displacement_ball", vector_displacement_ball, 0, 128, 512),
+    ("displacement_wave_ball", lambda: vector_displacement_ball(False), 0, 128, 512),
     ("mapping_scale_rotation", mapping_image, 0, 64, 256),
     ("mix_diffuse_glossy_layer_weight", mix_layer_weight, 0, 256, 1024),
     ("add_diffuse_glossy_fresnel", add_fresnel, 0, 256, 1024),

@@ -142,11 +142,17 @@ impl ClosureOp {
             })
         };
         let col = |c: Slot| s.v(c).max(Vec3::ZERO);
+        let surface_normal = if g.n_displaced {
+            world_normal(g.n, g)
+        } else {
+            Vec3::ZERO
+        };
         let push = |out: &mut ClosureSet, weight: Vec3, normal: Vec3, tangent: Vec3, kind| {
             out.push(Closure {
                 weight,
                 normal,
                 tangent,
+                surface_normal,
                 kind,
             })
         };
@@ -302,6 +308,17 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
     let normal = |cx: &mut NodeCx, id: &str| -> Result<Option<Slot>, CompileError> {
         if cx.is_linked(id) {
             cx.vector(id, Vec3::ZERO).map(Some)
+        } else if cx.displaced() && id != "Tangent" {
+            // Unlinked, the normal is N: after a displacement, the displaced one.
+            let n = cx.alloc(3)?;
+            cx.emit(
+                Op::Input(super::input::InputOp {
+                    src: super::input::Source::Normal,
+                    out: n,
+                }),
+                true,
+            );
+            Ok(Some(n))
         } else {
             Ok(None)
         }
