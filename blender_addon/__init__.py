@@ -13,12 +13,13 @@ bl_info = {
 
 if "bpy" in locals():  # reload support (F3 > Reload Scripts)
     import importlib
-    for _m in (compat, protocol, report, export, properties, preferences, engine, ui):  # noqa: F821
+    for _m in (compat, protocol, process, report, export, properties, preferences, engine,  # noqa: F821
+               ui):
         importlib.reload(_m)
 
 import bpy  # noqa: E402
 
-from . import compat, protocol, report, export, properties, preferences, engine, ui  # noqa: E402,F401
+from . import compat, protocol, process, report, export, properties, preferences, engine, ui  # noqa: E402,F401,E501
 
 _MODULES = (properties, preferences, engine, ui)
 
