@@ -10,7 +10,7 @@ import time
 import bpy
 import numpy as np
 
-from . import compat, export, passes, preferences, protocol, report
+from . import compat, export, passes, preferences, protocol, report, viewport
 from .process import StderrTail, _describe_exit, make_tmpdir, stop_process, sweep_stale_tmpdirs
 
 POLL_SECONDS = 0.03        # how often render() looks at the queue and test_break()
@@ -142,6 +142,38 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
     def __init__(self, *args, **kwargs):
         # Blender 4.4+ passes arguments here; older versions pass none.
         super().__init__(*args, **kwargs)
+        self.viewport = None
+
+    def __del__(self):
+        # Blender frees a viewport's engine when Rendered shading ends, the area closes or the
+        # engine changes: the session process ends with it.
+        vs = getattr(self, "viewport", None)
+        if vs is not None:
+            vs.close()
+
+    # -- viewport -----------------------------------------------------------------------------
+
+    def view_update(self, context, depsgraph):
+        if self.viewport is None:
+            self.viewport = viewport.new_session(self)
+        try:
+            self.viewport.update(self, context, depsgraph)
+        except Exception as exc:  # noqa: BLE001 - never take Blender down, always say why
+            import traceback
+            traceback.print_exc()
+            self.viewport.message = "internal error in the add-on: %s: %s" % (
+                type(exc).__name__, exc)
+
+    def view_draw(self, context, depsgraph):
+        if self.viewport is None:
+            return
+        try:
+            self.viewport.draw(self, context, depsgraph)
+        except Exception as exc:  # noqa: BLE001
+            import traceback
+            traceback.print_exc()
+            self.viewport.message = "internal error in the add-on: %s: %s" % (
+                type(exc).__name__, exc)
 
     # -- helpers --------------------------------------------------------------
 
