@@ -13,10 +13,11 @@ Environment:
 
 After each `view` (once it has a `load`) it sends two IMAGE frames: pixel size 2, then 1
 (flag "last"). Pixel (X, Y) of the view (top-left origin) is
-  R = (X + 0.5) / W, G = (Y + 0.5) / H, B = generation / 1000, A = 1
+  R = (X + 0.5) / W, G = (Y + 0.5) / H, B = (generation mod 8) / 8, A = 1
 (a data pixel at pixel size 2 takes the value of its top-left view pixel).
 """
 
+import array
 import json
 import os
 import signal
@@ -54,16 +55,14 @@ def image(generation, view, pixel_size, last):
     samples = 4 if pixel_size == 1 else 1
     head = struct.pack("<Q11I", generation, w, h, x0, y0, bw, bh, pixel_size, dw, dh, samples,
                        1 if last else 0)
-    reds = [(x0 + i * pixel_size + 0.5) / w for i in range(dw)]
-    blue = generation / 1000.0
-    pack = struct.Struct("<%df" % (4 * dw)).pack
+    row = array.array("f", bytes(16 * dw))
+    row[0::4] = array.array("f", [(x0 + i * pixel_size + 0.5) / w for i in range(dw)])
+    row[2::4] = array.array("f", [(generation % 8) / 8.0]) * dw
+    row[3::4] = array.array("f", [1.0]) * dw
     rows = []
     for j in range(dh):
-        green = (y0 + j * pixel_size + 0.5) / h
-        values = []
-        for r in reds:
-            values += (r, green, blue, 1.0)
-        rows.append(pack(*values))
+        row[1::4] = array.array("f", [(y0 + j * pixel_size + 0.5) / h]) * dw
+        rows.append(row.tobytes())
     return frame(IMAGE, head + b"".join(rows))
 
 
