@@ -229,20 +229,45 @@ def s_restarted(ctx):
 @step
 def s_left(ctx):
     record("left")
+    area3d().spaces[0].shading.type = "RENDERED"
+    return lambda: image_ready()
+
+
+@step
+def s_again(ctx):
+    record("again")
+    ctx["again_pid"] = live_session().client.proc.pid
+    # Opening a file ends the session at once (load_pre), before the new file's UI exists.
+    bpy.ops.wm.open_mainfile(filepath=bpy.data.filepath)
+    state["after_open_alive"] = pid_alive(ctx["again_pid"])
+    return lambda: True
+
+
+@step
+def s_opened(ctx):
+    setup()
+    return lambda: image_ready()
+
+
+@step
+def s_quit(ctx):
+    record("before_quit")
     state["pids"] = [s.get("pid") for s in state["steps"] if s.get("pid")]
     return None
 
 
+def pid_alive(pid):
+    try:
+        os.kill(pid, 0)
+        with open("/proc/%d/stat" % pid) as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except (ProcessLookupError, OSError):
+        return False
+
+
 def finish():
-    state["alive_after"] = []
-    for pid in set(state.get("pids", [])):
-        try:
-            os.kill(pid, 0)
-            with open("/proc/%d/stat" % pid) as f:
-                if f.read().rsplit(")", 1)[1].split()[0] != "Z":
-                    state["alive_after"].append(pid)
-        except (ProcessLookupError, OSError):
-            pass
+    # The last session still runs: quitting Blender must end it (the pytest side checks).
+    state["alive_before_quit"] = sorted(p for p in set(state.get("pids", [])) if pid_alive(p))
     with open(os.path.join(OUT, "status.json"), "w") as f:
         json.dump(state, f, indent=1)
     bpy.ops.wm.quit_blender()
@@ -281,4 +306,4 @@ def tick():
         return None
 
 
-bpy.app.timers.register(tick, first_interval=1.0)
+bpy.app.timers.register(tick, first_interval=1.0, persistent=True)

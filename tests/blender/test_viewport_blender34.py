@@ -133,11 +133,26 @@ def test_killed_session_is_reported_and_replaced(gui_run):
     restarted = steps["restarted"]
     assert restarted["pid"] != killed["pid"] and restarted["dead"] is None
     assert restarted["sent"][-3:] == ["load", "settings", "view"]
-    assert len([c for c in cmds if "start" in c]) == 2
+    starts = [c["start"] for c in cmds if "start" in c]
+    assert starts[:2] == [killed["pid"], restarted["pid"]]
 
 
-def test_leaving_rendered_ends_the_session(gui_run):
-    status, steps, _, tmp = gui_run
+def test_leaving_rendered_opening_a_file_and_quitting_end_the_session(gui_run):
+    status, steps, cmds, tmp = gui_run
     assert steps["left"]["sessions"] == 0
-    assert status["alive_after"] == []
+    assert steps["restarted"]["pid"] not in status["alive_before_quit"]
+    assert status["after_open_alive"] is False
+    last = steps["before_quit"]["pid"]
+    assert status["alive_before_quit"] == [last]  # only the newest file's session ran
+    assert not pid_alive(last)  # Blender quit: gone
+    assert len([c for c in cmds if "start" in c]) == 4
     assert leftovers(tmp) == []
+
+
+def pid_alive(pid):
+    try:
+        os.kill(pid, 0)
+        with open("/proc/%d/stat" % pid) as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except (ProcessLookupError, OSError):
+        return False
