@@ -15,7 +15,7 @@ import time
 
 import bpy
 
-OUT = sys.argv[sys.argv.index("--") + 1:][0]
+OUT = sys.argv[sys.argv.index("--") + 1:][0] if __name__ == "__main__" else None
 STEP_TIMEOUT = 60.0
 state = {"version": bpy.app.version_string, "steps": [], "error": None}
 
@@ -306,4 +306,5 @@ def tick():
         return None
 
 
-bpy.app.timers.register(tick, first_interval=1.0, persistent=True)
+if __name__ == "__main__":
+    bpy.app.timers.register(tick, first_interval=1.0, persistent=True)

@@ -156,3 +156,45 @@ def pid_alive(pid):
             return f.read().rsplit(")", 1)[1].split()[0] != "Z"
     except (ProcessLookupError, OSError):
         return False
+
+
+def session_binary():
+    """The real renderer when it has the session subcommand (TESELA_SESSION_BIN, TESELA_BIN,
+    else target/release/tesela)."""
+    import subprocess
+    repo = HERE.parent.parent
+    path = os.environ.get("TESELA_SESSION_BIN") or os.environ.get("TESELA_BIN") \
+        or str(repo / "target" / "release" / "tesela")
+    if not (os.path.isfile(path) and os.access(path, os.X_OK)):
+        pytest.skip("no tesela binary at %s (set TESELA_SESSION_BIN or TESELA_BIN)" % path)
+    if subprocess.run([path, "session", "--help"], capture_output=True, timeout=30).returncode:
+        pytest.skip("%s has no 'session' subcommand yet (branch session lands it)" % path)
+    return path
+
+
+def test_camera_view_equals_f12(env34):
+    """Real renderer: the viewport in camera view (frame filling the region, 8 samples, pixel
+    size 1) shows what F12 renders of the same view, through the same view transform."""
+    binary = session_binary()
+    base, env = env34
+    blend = make_scene(base, env, "viewport f12.blend", w=64, h=48)
+    tmp = private_tmp(base, "tmp viewport f12")
+    out = base / "viewport f12 out"
+    out.mkdir()
+    env = dict(env, TESELA_BINARY=binary)
+    p = run([XVFB, "-a", "-s", "-screen 0 1280x800x24", "env", "TMPDIR=" + str(tmp),
+             BLENDER, "-p", "0", "0", "400", "300", "--addons", "tesela", str(blend),
+             "--python", str(HERE / "blender34_viewport_f12.py"), "--", str(out), "8"],
+            env, timeout=300)
+    status_path = out / "status.json"
+    assert status_path.is_file(), p.stdout[-3000:] + p.stderr[-3000:]
+    status = json.loads(status_path.read_text())
+    assert status["error"] is None, status
+    assert status["samples"] == 8
+    view = screenshot(out / "viewport.png")
+    f12 = screenshot(out / "f12.png")
+    w, h = status["region"]
+    assert f12.shape == (h, w, 3) and view.shape[:2] == (h, w)
+    err = np.abs(interior(view) - interior(f12)).max(axis=-1)
+    assert (err <= 2.5 / 255).mean() > 0.99, (err > 2.5 / 255).mean()
+    assert leftovers(tmp) == []
