@@ -180,6 +180,23 @@ def s_persp(ctx):
 def s_ortho(ctx):
     record("ortho")
     ctx["gen"] = generation()
+    space = area3d().spaces[0]
+    space.use_render_border = True
+    space.render_border_min_x, space.render_border_max_x = 0.25, 0.75
+    space.render_border_min_y, space.render_border_max_y = 0.5, 0.9
+    area3d().tag_redraw()
+    return lambda: image_ready(ctx["gen"])
+
+
+@step
+def s_border(ctx):
+    record("border")
+    vs = live_session()
+    state["border_sent"] = vs.view_fields.get("border")
+    img = vs.client.image
+    state["border_image"] = [img.x, img.y, img.width, img.height]
+    area3d().spaces[0].use_render_border = False
+    ctx["gen"] = generation()
     set_view("camera")
     return lambda: image_ready(ctx["gen"])
 

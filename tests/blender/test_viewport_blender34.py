@@ -96,6 +96,24 @@ def test_viewport_shows_the_session_image(gui_run):
         assert (err <= 2.5 / 255).mean() > 0.99, (name, (err > 2.5 / 255).mean())
 
 
+def test_viewport_border_draws_its_window(gui_run):
+    status, steps, _, _ = gui_run
+    s = steps["border"]
+    w, h = s["region"][:2]
+    x0, x1 = int(0.25 * w), int(0.75 * w)
+    top, bottom = h - int(0.9 * h), h - int(0.5 * h)
+    assert status["border_sent"] == [x0, top, x1 - x0, bottom - top]
+    assert status["border_image"] == status["border_sent"]
+    shot = screenshot(s["shot"])
+    want = fake_display(w, h, s["generation"])
+    inside = (slice(top + 2, bottom - 2), slice(x0 + 2, x1 - 2))
+    err = np.abs(shot[inside] - want[inside]).max(axis=-1)
+    assert (err <= 2.5 / 255).mean() > 0.99
+    # Outside the border the previous view's image is not drawn.
+    below = (slice(bottom + 5, h - 12), slice(12, w - 12))
+    assert (np.abs(shot[below] - want[below]).max(axis=-1) > 0.05).mean() > 0.5
+
+
 def test_views_are_blenders_projection(gui_run):
     _, steps, _, _ = gui_run
     for name, kind in (("persp", "PERSP"), ("ortho", "ORTHO"), ("camera", "CAMERA")):
