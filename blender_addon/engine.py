@@ -131,10 +131,30 @@ class progress_lines:
         return True
 
 
+PREVIEW_SAMPLES_MAX = 64
+
+
+class PreviewSettings:
+    """scene.tesela for a material, light or world preview (the Properties editor's sphere and
+    the icons): the viewport's sample count, at most PREVIEW_SAMPLES_MAX, and no denoiser, so a
+    preview stays a short render in Blender's preview job."""
+
+    def __init__(self, settings):
+        self._settings = settings
+
+    def __getattr__(self, name):
+        if name == "samples":
+            wanted = int(self._settings.preview_samples) or PREVIEW_SAMPLES_MAX
+            return max(1, min(wanted, PREVIEW_SAMPLES_MAX))
+        if name == "use_denoising":
+            return False
+        return getattr(self._settings, name)
+
+
 class TeselaRenderEngine(bpy.types.RenderEngine):
     bl_idname = "TESELA"
     bl_label = "Tesela"
-    bl_use_preview = False
+    bl_use_preview = True
     bl_use_postprocess = True
     bl_use_shading_nodes_custom = False
     bl_use_eevee_viewport = True
@@ -204,7 +224,7 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
     def render(self, depsgraph):
         scene = depsgraph.scene
         r = scene.render
-        settings = scene.tesela
+        settings = PreviewSettings(scene.tesela) if self.is_preview else scene.tesela
         width, height = export.render_size(r)
         region = export.border_region(r, width, height)
         _, _, rw, rh = region if region is not None else (0, 0, width, height)

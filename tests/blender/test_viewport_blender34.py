@@ -216,3 +216,33 @@ def test_camera_view_equals_f12(env34):
     err = np.abs(interior(view) - interior(f12)).max(axis=-1)
     assert (err <= 2.5 / 255).mean() > 0.99, (err > 2.5 / 255).mean()
     assert leftovers(tmp) == []
+
+
+def test_material_preview_icon_is_rendered_by_tesela(env34):
+    """bl_use_preview: Blender's preview job renders the material icon with Tesela."""
+    binary = env34_renderer()
+    base, env = env34
+    blend = make_scene(base, env, "preview.blend", w=64, h=48)
+    tmp = private_tmp(base, "tmp preview")
+    status_path = base / "preview status.json"
+    env = dict(env, TESELA_BINARY=binary)
+    p = run([XVFB, "-a", "-s", "-screen 0 1280x800x24", "env", "TMPDIR=" + str(tmp),
+             BLENDER, "-p", "0", "0", "1000", "700", "--addons", "tesela", str(blend),
+             "--python", str(HERE / "blender34_preview.py"), "--", str(status_path)],
+            env, timeout=200)
+    assert status_path.is_file(), p.stdout[-3000:] + p.stderr[-3000:]
+    status = json.loads(status_path.read_text())
+    assert status["error"] is None, status
+    r, g, b, _ = status["icon_mean"]
+    assert g > 1.5 * r and g > 1.5 * b  # the green material
+    assert "Tesela: 100% | Sample 64/64" in p.stdout  # PREVIEW_SAMPLES_MAX, by Tesela
+    assert leftovers(tmp) == []
+
+
+def env34_renderer():
+    """The real renderer for F12-like renders (TESELA_BIN, else target/release/tesela)."""
+    repo = HERE.parent.parent
+    path = os.environ.get("TESELA_BIN") or str(repo / "target" / "release" / "tesela")
+    if not (os.path.isfile(path) and os.access(path, os.X_OK)):
+        pytest.skip("no tesela binary at %s (set TESELA_BIN)" % path)
+    return path
