@@ -31,7 +31,7 @@ from blender_addon.viewport import interactive, session_client, updates  # noqa:
 from blender_addon.viewport import session_protocol as sp  # noqa: E402
 from blender_addon.viewport import view_camera as vc  # noqa: E402
 
-from test_addon import simple_scene  # noqa: E402
+from test_addon import simple_scene, use_nodes  # noqa: E402
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -387,9 +387,13 @@ def test_material_with_an_image_asks_for_a_load(recorder):
     tex = mat.node_tree.nodes.new("ShaderNodeTexImage")
     tex.image = img
     bsdf = next(n for n in mat.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
-    load, _ = recorder.run(lambda: mat.node_tree.links.new(tex.outputs[0],
-                                                           bsdf.inputs["Base Color"]))
-    assert load
+    try:
+        load, _ = recorder.run(lambda: mat.node_tree.links.new(tex.outputs[0],
+                                                               bsdf.inputs["Base Color"]))
+        assert load
+    finally:  # the other tests share the material
+        mat.node_tree.nodes.remove(tex)
+        bpy.data.images.remove(img)
 
 
 def test_geometry_edit_sends_mesh(recorder):
@@ -548,3 +552,60 @@ def test_real_session_equals_f12_render(tmp_path):
         c.close()
     assert got.samples == spp and got.pixel_size == 1
     assert np.array_equal(got.pixels[..., :3], want[..., :3])
+
+
+def test_real_session_takes_every_edit(monkeypatch, tmp_path):
+    """view_update's commands against the real session: each edit is accepted (no ERROR
+    frame), renders a new generation, and changes the image."""
+    import tempfile
+    binary = session_binary()
+    monkeypatch.setenv("TESELA_BINARY", binary)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    scene = simple_scene(24, 16)
+    scene.tesela.preview_samples = 2
+    scene.world = scene.world or bpy.data.worlds.new("World")
+    use_nodes(scene.world)
+    background = next(n for n in scene.world.node_tree.nodes if n.type == "BACKGROUND")
+    engine = StandInEngine()
+    vs = interactive.ViewportSession(engine)
+    vs.record = True
+    ctx = stand_in_context(24, 16)
+
+    def handler(scene, depsgraph):
+        vs.update(engine, ctx, depsgraph)
+    bpy.app.handlers.depsgraph_update_post.append(handler)
+    try:
+        vs.update(engine, ctx, bpy.context.evaluated_depsgraph_get())
+
+        def settled():
+            c = vs.client
+            return c.image is not None and c.image.last and c.image.samples == 2
+        assert wait_for(settled, 60), vs.client.dead
+        cube = bpy.data.objects["Cube"]
+        bsdf = next(n for n in bpy.data.materials["TestRed"].node_tree.nodes
+                    if n.type == "BSDF_PRINCIPLED")
+
+        def edit_mesh():
+            cube.data.vertices[7].co.z += 0.5
+            cube.data.update()
+        edits = [("transform", lambda: setattr(cube, "location", (-0.2, -0.5, 0.0))),
+                 ("light", lambda: setattr(bpy.data.objects["Lamp"].data, "energy", 2000.0)),
+                 ("material", lambda: bsdf.inputs["Base Color"].__setattr__(
+                     "default_value", (0.1, 0.1, 0.9, 1.0))),
+                 ("mesh", edit_mesh),
+                 ("visibility", lambda: cube.hide_set(True)),
+                 ("world", lambda: background.inputs["Color"].__setattr__(
+                     "default_value", (0.3, 0.3, 0.05, 1.0)))]
+        for cmd, edit in edits:
+            before = vs.client.image
+            vs.sent.clear()
+            edit()
+            bpy.context.evaluated_depsgraph_get().update()
+            assert cmd in [c for c, _ in vs.sent], (cmd, vs.sent)
+            assert wait_for(lambda: settled() and vs.client.image.generation > before.generation,
+                            60), (cmd, vs.client.dead, vs.client.errors)
+            assert vs.client.errors == [] and vs.client.dead is None, cmd
+            assert not np.array_equal(vs.client.image.pixels, before.pixels), cmd
+    finally:
+        bpy.app.handlers.depsgraph_update_post.remove(handler)
+        vs.close()
