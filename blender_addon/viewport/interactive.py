@@ -64,6 +64,15 @@ def view_command(context, scene, width, height):
     return fields, json.dumps(fields, sort_keys=True)
 
 
+def _remove_gltf(path):
+    """A .gltf and the .bin the exporter wrote beside it."""
+    for p in (path, os.path.splitext(path)[0] + ".bin"):
+        try:
+            os.remove(p)
+        except OSError:
+            pass
+
+
 class ViewportSession:
     """Everything one Rendered viewport owns: the client, its temp folder, what was sent."""
 
@@ -83,6 +92,8 @@ class ViewportSession:
         self._files = 0
         self._timer = None
         self._depsgraph = None
+        self._mesh_files = {}        # object name -> (id, path) of its newest `mesh` command
+        self._superseded = set()     # ids of commands whose errors no longer matter
 
     # -- life ---------------------------------------------------------------------------------
 
@@ -96,11 +107,22 @@ class ViewportSession:
             self.tmpdir = None
         self.display.free()
         self.index = None
+        self._mesh_files.clear()
+        self._superseded.clear()  # command ids start again with the next session
 
     def _send(self, cmd, **fields):
         if self.record:
             self.sent.append((cmd, fields))
-        self.client.send(cmd, **fields)
+        return self.client.send(cmd, **fields)
+
+    def _mesh_sent(self, name, command_id, path):
+        """Only an object's newest mesh file is kept: an older one the session has not read
+        yet can only fail, and its ERROR is then ignored (the newer mesh follows it)."""
+        old = self._mesh_files.pop(name, None)
+        if old is not None:
+            self._superseded.add(old[0])
+            _remove_gltf(old[1])
+        self._mesh_files[name] = (command_id, path)
 
     def _start(self, depsgraph):
         """A new session with the whole scene; False (and `message`) when it cannot start."""
@@ -134,6 +156,8 @@ class ViewportSession:
     def _load(self, depsgraph):
         """Export the whole scene as F12 does and send `load` (the files of earlier loads and
         meshes are no longer read by the session once this one is queued after them)."""
+        self._superseded.update(cid for cid, _ in self._mesh_files.values())
+        self._mesh_files.clear()
         for name in os.listdir(self.tmpdir):
             path = os.path.join(self.tmpdir, name)
             if os.path.isdir(path):
@@ -204,7 +228,9 @@ class ViewportSession:
                 self._load(depsgraph)
             else:
                 for cmd, fields in tr.commands:
-                    self._send(cmd, **fields)
+                    cid = self._send(cmd, **fields)
+                    if cmd == "mesh":
+                        self._mesh_sent(fields["name"], cid, fields["path"])
         self._send_settings(engine, depsgraph.scene)
         self._send_view(context, depsgraph.scene)
 
@@ -224,6 +250,10 @@ class ViewportSession:
         if fields is not None:
             self._send("view", **fields)
         return True
+
+    def take_errors(self):
+        """The texts of the client's new ERROR frames that still matter."""
+        return [e.text() for e in self.client.take_errors() if e.id not in self._superseded]
 
     # -- view_draw ------------------------------------------------------------------------------
 
@@ -246,7 +276,7 @@ class ViewportSession:
         if client is not None:
             with client.lock:
                 image, serial, dead = client.image, client.serial, client.dead
-            self.errors = (self.errors + client.take_errors())[-MAX_ERRORS_SHOWN:]
+            self.errors = (self.errors + self.take_errors())[-MAX_ERRORS_SHOWN:]
         if (image is not None and self.view_fields is not None
                 and (image.view_width, image.view_height) == (region.width, region.height)):
             self.display.update(image, serial)

@@ -30,7 +30,7 @@ class SessionClient:
     """One `tesela session` process and its two threads.
 
     State the UI thread reads (under `lock`): `image` (the newest sp.Image or None), `serial`
-    (grows with every new image), `errors` (messages of ERROR frames not yet shown), `stats`
+    (grows with every new image), `errors` (the ERROR frames not yet taken), `stats`
     (the last STATS object), `dead` (None while the session lives, else why it ended)."""
 
     def __init__(self, binary, *, threads=0, oidn_lib=None, cwd=None, on_change=None):
@@ -118,6 +118,7 @@ class SessionClient:
     # -- frames -------------------------------------------------------------------------------
 
     def take_errors(self):
+        """The ERROR frames (session_protocol.Error) that arrived since the last call."""
         with self.lock:
             errors, self.errors = self.errors, []
         return errors
@@ -144,7 +145,7 @@ class SessionClient:
                     self._changed()
                 elif isinstance(msg, sp.Error):
                     with self.lock:
-                        self.errors.append(msg.text())
+                        self.errors.append(msg)
                     if msg.fatal:
                         why = msg.text()
                     self._changed()

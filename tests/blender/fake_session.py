@@ -10,6 +10,10 @@ Environment:
                       message, as a renderer without the subcommand)
   FAKE_SESSION_LOG    append one JSON line per command received (plus a "start" line with
                       the pid and argv)
+  FAKE_SESSION_DELAY  seconds to wait before taking each command (default 0)
+
+A `mesh` or `load` whose file does not exist is answered by an ERROR frame, as the real session
+answers a file it cannot read.
 
 After each `view` (once it has a `load`) it sends two IMAGE frames: pixel size 2, then 1
 (flag "last"). Pixel (X, Y) of the view (top-left origin) is
@@ -23,6 +27,7 @@ import os
 import signal
 import struct
 import sys
+import time
 
 COMMAND, HELLO, ERROR, IMAGE, STATS = 32, 1, 5, 16, 17
 
@@ -91,12 +96,20 @@ def main():
             sys.exit(0)
         if kind != COMMAND:
             continue
+        time.sleep(float(os.environ.get("FAKE_SESSION_DELAY", "0")))
         (n,) = struct.unpack_from("<I", payload, 0)
         cmd = json.loads(payload[4:4 + n].decode("utf-8"))
         log(cmd)
         name = cmd.get("cmd")
         if name == "stop":
             sys.exit(0)
+        path = cmd.get("path")
+        if name in ("mesh", "load") and not os.path.isfile(str(path)):
+            out.write(frame(ERROR, json.dumps({"command": name, "id": cmd.get("id"),
+                                               "message": "cannot read %s" % path,
+                                               "fatal": False}).encode()))
+            out.flush()
+            continue
         if mode == "error" and name == "material":
             out.write(frame(ERROR, json.dumps({"command": "material", "id": cmd.get("id"),
                                                "message": "no material named '%s'" % cmd.get("name"),

@@ -117,7 +117,7 @@ def test_reader_rejects_other_versions_and_programs():
 def test_client_keeps_the_newest_image(fake):
     c = session_client.SessionClient(str(FAKE)).start()
     try:
-        c.send("load", path="scene.gltf")
+        c.send("load", path=str(FAKE))
         c.send("view", width=30, height=20, camera={})
         assert wait_for(lambda: c.image is not None and c.image.last)
         first = c.image
@@ -139,9 +139,11 @@ def test_client_collects_error_frames_and_survives(fake, monkeypatch):
     monkeypatch.setenv("FAKE_SESSION_MODE", "error")
     c = session_client.SessionClient(str(FAKE)).start()
     try:
-        c.send("material", name="Nope", material={})
+        cid = c.send("material", name="Nope", material={})
         assert wait_for(lambda: c.errors)
-        assert c.take_errors() == ["material: no material named 'Nope'"]
+        errors = c.take_errors()
+        assert [e.text() for e in errors] == ["material: no material named 'Nope'"]
+        assert errors[0].id == cid and not errors[0].fatal
         assert c.take_errors() == [] and c.alive()
     finally:
         c.close()
@@ -152,7 +154,7 @@ def test_client_reports_a_session_killed_mid_frame(fake, monkeypatch):
     changes = []
     c = session_client.SessionClient(str(FAKE), on_change=lambda: changes.append(1)).start()
     try:
-        c.send("load", path="scene.gltf")
+        c.send("load", path=str(FAKE))
         c.send("view", width=8, height=8, camera={})
         assert wait_for(lambda: c.image is not None and c.image.last)
         c.send("view", width=9, height=9, camera={})
@@ -497,6 +499,47 @@ def test_viewport_session_commands_and_restart(fake, tmp_path, monkeypatch):
     assert [n for n in os.listdir(tmp_path) if n.startswith("tesela")] == []
     for pid in starts:
         assert not process._pid_alive(pid)
+
+
+def test_only_the_newest_mesh_file_is_kept(fake, tmp_path, monkeypatch):
+    """Two geometry edits in a row: the first mesh file goes at once; the slow session's ERROR
+    for it (it cannot read it any more) is not shown, since the second mesh supersedes it."""
+    import tempfile
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    monkeypatch.setenv("FAKE_SESSION_DELAY", "0.05")
+    simple_scene(32, 24)
+    engine = StandInEngine()
+    vs = interactive.ViewportSession(engine)
+    vs.record = True
+    ctx = stand_in_context()
+
+    def handler(scene, depsgraph):
+        vs.update(engine, ctx, depsgraph)
+    bpy.app.handlers.depsgraph_update_post.append(handler)
+    cube = bpy.data.objects["Cube"]
+    try:
+        vs.update(engine, ctx, bpy.context.evaluated_depsgraph_get())
+        for dz in (0.1, 0.2):
+            cube.data.vertices[7].co.z += dz
+            cube.data.update()
+            bpy.context.evaluated_depsgraph_get().update()
+        meshes = [f["path"] for c, f in vs.sent if c == "mesh"]
+        assert len(meshes) == 2
+        assert not os.path.exists(meshes[0]) and os.path.isfile(meshes[1])
+        assert wait_for(lambda: len([e for e in fake_log(fake) if e.get("cmd") == "mesh"]) == 2)
+        assert wait_for(lambda: vs.client.errors)  # the fake could not read the first one
+        assert vs.take_errors() == []
+        vs.sent.clear()
+        cube.data.vertices[7].co.z += 0.3  # a mesh the session cannot read is shown
+        cube.data.update()
+        bpy.context.evaluated_depsgraph_get().update()
+        _remove = [f["path"] for c, f in vs.sent if c == "mesh"][0]
+        os.remove(_remove)
+        assert wait_for(lambda: vs.client.errors)
+        assert vs.take_errors() == ["mesh: cannot read %s" % _remove]
+    finally:
+        bpy.app.handlers.depsgraph_update_post.remove(handler)
+        vs.close()
 
 
 def test_viewport_session_without_renderer_says_why(monkeypatch, tmp_path):
