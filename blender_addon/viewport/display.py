@@ -34,23 +34,35 @@ class Display:
         self.serial = serial
 
     def draw(self, engine, scene, region_height):
-        """Draw the image into its window of the view (region pixels, bottom-left origin)."""
-        image = self.image
-        if self.texture is None or image is None:
+        """Draw the image where it lies in the view (region pixels, bottom-left origin)."""
+        rect = self.placement(self.image)
+        if self.texture is None or rect is None:
             return
         import gpu
-        ps = image.pixel_size
-        dh, dw = image.pixels.shape[:2]
-        # The data covers dw*ps x dh*ps view pixels from the window's top-left corner; the last
-        # column and row are cut by the window's edge, so the texture coordinates stop there.
-        u1 = image.width / float(dw * ps)
-        v0 = 1.0 - image.height / float(dh * ps)
-        x0 = image.x
-        y0 = region_height - image.y - image.height
+        (x0, top, w, h), uv = rect
         gpu.state.blend_set("ALPHA_PREMULT")
         compat.draw_scene_linear_texture(engine, scene, self.texture,
-                                         (x0, y0, image.width, image.height), (0.0, v0, u1, 1.0))
+                                         (x0, region_height - top - h, w, h), uv)
         gpu.state.blend_set("NONE")
+
+    @staticmethod
+    def placement(image):
+        """((x, y, w, h) in view pixels, top-left origin; (u0, v0, u1, v1) texture coordinates
+        of the flipped texture) of the part of the window the image's data covers, or None."""
+        if image is None:
+            return None
+        ps = image.pixel_size
+        dh, dw = image.pixels.shape[:2]
+        # The data's cells start at the cell holding the window's corner; the data may end
+        # before the window does (cut at the view's edge) or after it (the last cell).
+        ox, oy = (image.x // ps) * ps, (image.y // ps) * ps
+        x1 = min(image.x + image.width, ox + dw * ps)
+        y1 = min(image.y + image.height, oy + dh * ps)
+        if x1 <= image.x or y1 <= image.y:
+            return None
+        u0, u1 = (image.x - ox) / (dw * ps), (x1 - ox) / (dw * ps)
+        v1, v0 = 1.0 - (image.y - oy) / (dh * ps), 1.0 - (y1 - oy) / (dh * ps)
+        return (image.x, image.y, x1 - image.x, y1 - image.y), (u0, v0, u1, v1)
 
 
 def draw_messages(lines, region_width, region_height):

@@ -70,8 +70,9 @@ class Error:
 
 class Image:
     """One progressive image: `pixels` float32 (data_height, data_width, 4), rows top to bottom,
-    linear radiance; it covers the window (x, y, width, height) of the view (top-left origin),
-    each data pixel `pixel_size` view pixels wide."""
+    linear radiance, for the window (x, y, width, height) of the view (top-left origin). Data
+    pixel (i, j) covers the view's pixel_size x pixel_size cell (x // pixel_size + i,
+    y // pixel_size + j), as the session renders a border at a reduced resolution."""
     __slots__ = ("generation", "view_width", "view_height", "x", "y", "width", "height",
                  "pixel_size", "samples", "flags", "pixels")
 
@@ -136,8 +137,10 @@ def decode(kind, payload):
         if len(payload) != expected:
             raise ProtocolError("IMAGE %dx%d: payload is %d bytes, expected %d"
                                 % (dw, dh, len(payload), expected))
-        if ps == 0 or dw != -(-w // ps) or dh != -(-h // ps):
-            raise ProtocolError("IMAGE data %dx%d does not cover a %dx%d window at pixel size %d"
+        # The data may be cut at the view's edges, and its grid of pixel_size cells starts at
+        # the cell holding the window's corner, so it spans at most one cell more.
+        if ps == 0 or dw > -(-w // ps) + 1 or dh > -(-h // ps) + 1:
+            raise ProtocolError("IMAGE data %dx%d does not fit a %dx%d window at pixel size %d"
                                 % (dw, dh, w, h, ps))
         pixels = np.frombuffer(payload, dtype="<f4", count=dw * dh * 4,
                                offset=_IMAGE_HEAD.size).reshape(dh, dw, 4)

@@ -90,9 +90,28 @@ def test_image_frame_decodes_window_and_rows():
     assert np.array_equal(msg.pixels, rgba)
     with pytest.raises(sp.ProtocolError, match="expected"):
         sp.decode(kind, data[8:-4])
-    bad = sp.image_frame(5, 40, 30, (0, 0, 7, 3), 2, 8, 0, rgba)  # 7 wide needs 4 columns
-    with pytest.raises(sp.ProtocolError, match="does not cover"):
+    bad = sp.image_frame(5, 40, 30, (0, 0, 2, 2), 2, 8, 0, rgba)  # 3 columns for 2 pixels
+    with pytest.raises(sp.ProtocolError, match="does not fit"):
         sp.decode(sp.IMAGE, bad[8:])
+
+
+def test_image_placement_on_the_cell_grid():
+    from blender_addon.viewport.display import Display
+
+    def image(window, ps, dw, dh, view=(40, 30)):
+        return sp.Image(1, view[0], view[1], *window, ps, 1, 0,
+                        np.zeros((dh, dw, 4), np.float32))
+    # Full resolution: the whole texture, where the window is.
+    assert Display.placement(image((3, 5, 10, 6), 1, 10, 6)) == ((3, 5, 10, 6), (0, 0, 1, 1))
+    # Pixel size 4, window at (6, 5) 10x7: cells start at (4, 4); 3x2 cells cover 4..16 x 4..12.
+    rect, uv = Display.placement(image((6, 5, 10, 7), 4, 3, 2))
+    assert rect == (6, 5, 10, 7)
+    assert uv == pytest.approx((2 / 12, 1 - 8 / 8, 12 / 12, 1 - 1 / 8))
+    # Fewer cells than the window spans: only what they cover is drawn (cells 28..36).
+    rect, uv = Display.placement(image((30, 0, 8, 8), 4, 2, 2))
+    assert rect == (30, 0, 6, 8) and uv[0] == pytest.approx(2 / 8) and uv[2] == 1.0
+    rect, uv = Display.placement(image((29, 0, 11, 8), 4, 2, 2))
+    assert rect == (29, 0, 7, 8)
 
 
 def test_reader_rejects_other_versions_and_programs():
