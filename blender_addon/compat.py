@@ -612,10 +612,11 @@ def draw_scene_linear_texture(engine, scene, texture, rect, uv):
     x, y, w, h = rect
     u0, v0, u1, v1 = uv
     shader = gpu.shader.from_builtin("IMAGE")
-    batch = batch_for_shader(
-        shader, "TRI_FAN",
+    batch = batch_for_shader(  # triangles: Blender 4+ backends have no triangle fans
+        shader, "TRIS",
         {"pos": ((x, y), (x + w, y), (x + w, y + h), (x, y + h)),
-         "texCoord": ((u0, v0), (u1, v0), (u1, v1), (u0, v1))})
+         "texCoord": ((u0, v0), (u1, v0), (u1, v1), (u0, v1))},
+        indices=((0, 1, 2), (2, 3, 0)))
     engine.bind_display_space_shader(scene)
     shader.bind()
     shader.uniform_sampler("image", texture)
