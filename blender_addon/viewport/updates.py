@@ -115,12 +115,20 @@ def translate(depsgraph, index, write_mesh, scratch_dir):
     out = Translation()
     lights, materials, meshes, moved = {}, {}, {}, {}
     world_changed = False
-    present = present_objects(depsgraph)
+    updates = list(depsgraph.updates)
+    # Adding, deleting, hiding or showing an object updates a collection or the scene; other
+    # edits leave the set of objects as it was, and walking every instance can be skipped.
+    structural = any(isinstance(u.id, (bpy.types.Collection, bpy.types.Scene)) for u in updates)
+    if structural or any(isinstance(u.id, bpy.types.Object) and u.id.name not in index.objects
+                         and u.id.type in EXPORTED_TYPES for u in updates):
+        present = present_objects(depsgraph)
+    else:
+        present = {name: ptr for name, ptr in index.objects.items() if index.visible[name]}
     for name, ptr in present.items():
         if index.objects.get(name) != ptr:
             out.need_load("object '%s' added" % name)
             return out
-    for u in depsgraph.updates:
+    for u in updates:
         idb = u.id
         if isinstance(idb, bpy.types.Object):
             name = idb.name

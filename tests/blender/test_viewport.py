@@ -447,6 +447,12 @@ def test_world_edit_sends_world(recorder):
     assert not load and [c for c, _ in cmds] == ["world"]
 
 
+def test_deleted_object_is_hidden(recorder):
+    load, cmds = recorder.run(lambda: bpy.data.objects.remove(bpy.data.objects["Cube"]))
+    assert not load and names(cmds) == [("visibility", "Cube")]
+    assert cmds[0][1]["visible"] is False
+
+
 def test_added_object_asks_for_a_load(recorder):
     def add():
         ob = bpy.data.objects.new("Another", bpy.data.meshes["Cube"])
