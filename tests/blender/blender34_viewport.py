@@ -251,6 +251,38 @@ def s_left(ctx):
 
 
 @step
+def s_engine_switch(ctx):
+    ctx["pid"] = live_session().client.proc.pid
+    bpy.context.scene.render.engine = "BLENDER_WORKBENCH"
+    area3d().tag_redraw()
+    return lambda: live_session() is None
+
+
+@step
+def s_engine_back(ctx):
+    state["engine_switch_alive"] = pid_alive(ctx["pid"])
+    bpy.context.scene.render.engine = "TESELA"
+    area3d().tag_redraw()
+    return lambda: image_ready()
+
+
+@step
+def s_area_switch(ctx):
+    ctx["pid"] = live_session().client.proc.pid
+    area3d().type = "TEXT_EDITOR"
+    return lambda: live_session() is None
+
+
+@step
+def s_area_back(ctx):
+    state["area_switch_alive"] = pid_alive(ctx["pid"])
+    for a in bpy.context.window_manager.windows[0].screen.areas:
+        if a.type == "TEXT_EDITOR":
+            a.type = "VIEW_3D"
+    return lambda: image_ready()
+
+
+@step
 def s_again(ctx):
     record("again")
     ctx["again_pid"] = live_session().client.proc.pid
@@ -306,7 +338,8 @@ def tick():
             run["settle"] = 2  # let Blender draw the frame it was told of
         if run["settle"]:
             run["settle"] -= 1
-            area3d().tag_redraw()
+            for a in bpy.context.window_manager.windows[0].screen.areas:
+                a.tag_redraw()
             return 0.2
         if run["i"] >= len(STEPS):
             finish()

@@ -160,10 +160,12 @@ def test_leaving_rendered_opening_a_file_and_quitting_end_the_session(gui_run):
     assert steps["left"]["sessions"] == 0
     assert steps["restarted"]["pid"] not in status["alive_before_quit"]
     assert status["after_open_alive"] is False
+    assert status["engine_switch_alive"] is False  # another render engine
+    assert status["area_switch_alive"] is False    # the area became another editor
     last = steps["before_quit"]["pid"]
     assert status["alive_before_quit"] == [last]  # only the newest file's session ran
     assert not pid_alive(last)  # Blender quit: gone
-    assert len([c for c in cmds if "start" in c]) == 4
+    assert len([c for c in cmds if "start" in c]) == 6  # the first, restart, 4 re-entries
     assert leftovers(tmp) == []
 
 
