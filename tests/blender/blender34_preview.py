@@ -51,8 +51,8 @@ def tick():
             state["icon_size"] = list(preview.icon_size)
             finish()
             return None
-        if time.monotonic() - state["t0"] > 60:
-            state["error"] = "no icon after 60 s"
+        if time.monotonic() - state["t0"] > 150:  # a loaded machine renders slowly
+            state["error"] = "no icon after 150 s"
             finish()
             return None
         return 0.5
