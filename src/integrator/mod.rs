@@ -130,17 +130,23 @@ impl ShadingPoint {
         if closure.normal != Vec3::ZERO
             && matches!(
                 bsdf,
-                BsdfInstance::Mirror(_) | BsdfInstance::RoughConductor(_)
+                BsdfInstance::Mirror(_)
+                    | BsdfInstance::RoughConductor(_)
+                    | BsdfInstance::Dielectric(_)
+                    | BsdfInstance::RoughDielectric(_)
             )
         {
-            // Specular reflection lobes (Glossy, metallic Principled) under a normal or bump
-            // map reflect above the geometric surface, as Cycles makes them.
+            // Specular lobes (Glossy, Glass, Refraction, metallic or transmissive Principled)
+            // under a normal or bump map reflect above the geometric surface, as Cycles makes
+            // them; the raised normal is found on the viewer's side and keeps its orientation.
             let ng = if its.ng.dot(-d) < 0.0 {
                 -its.ng
             } else {
                 its.ng
             };
-            n = bsdf::closure::valid_specular_normal(ng, -d, n);
+            let flip = n.dot(-d) < 0.0;
+            let m = bsdf::closure::valid_specular_normal(ng, -d, if flip { -n } else { n });
+            n = if flip { -m } else { m };
         }
         let rotation = anisotropic_rotation(&closure.kind);
         let tangent = match rotation {

@@ -240,6 +240,30 @@ def normal_map_glossy():
                  camera=((0.0, -3.0, 0.8), (0.0, 0.5, 0.0)))
 
 
+def normal_map_glass():
+    """A rough Glass BSDF floor (roughness 0.2) under strong normal-map normals, seen at
+    grazing angles against a bright world and a high sun: as for the metal, Cycles raises
+    normals that would reflect the view below the surface, for glass too."""
+    img = image("Bumps", bumpy_normal_px(amp=0.08), non_color=True)
+    mat, nt, out = node_material("NormalMappedGlass")
+    tex = image_node(nt, img)
+    nm = node(nt, "ShaderNodeNormalMap", {"space": "TANGENT", "uv_map": "UVMap"},
+              Strength=1.0, Color=tex.outputs["Color"])
+    surface(nt, out, node(nt, "ShaderNodeBsdfGlass", Color=(0.9, 0.95, 1.0, 1.0),
+                          Roughness=0.2, IOR=1.45, Normal=nm.outputs["Normal"]).outputs[0])
+    _floor_stage(mat, sun_dir=(-0.3, 0.2, -1.0), sun=3.0, world_strength=1.0,
+                 camera=((0.0, -3.0, 0.8), (0.0, 0.5, 0.0)))
+
+
+def glass_tinted_ball():
+    """A tinted rough Glass BSDF ball (colour (0.9, 0.5, 0.3), roughness 0.1): the colour
+    tints every reflection and refraction, as the closure's weight."""
+    mat, nt, out = node_material("TintedGlass")
+    surface(nt, out, node(nt, "ShaderNodeBsdfGlass", Color=(0.9, 0.5, 0.3, 1.0),
+                          Roughness=0.1, IOR=1.45).outputs[0])
+    _sphere_stage(mat)
+
+
 def noise_bump():
     """Bump (strength 0.8) from a Noise texture's Fac into a Principled BSDF, grazing sun."""
     mat, nt, out = node_material("NoiseBump")
@@ -508,12 +532,21 @@ SSS_REASON = ("approximation: Tesela renders Principled subsurface as diffuse (n
               "ball up to 6% brighter in Tesela, blue channel)")
 
 
+GLASS_NORMAL_MAP_REASON = (
+    "rough glass under strong normal-map normals at grazing views: means 0.992x, block p95 "
+    "0.054 against the 0.05 tolerance (max 0.17 in the far corner; before the glass normals "
+    "were raised above the surface 0.82x, p95 0.69)")
+
+
 # (id, builder, Cycles max_bounces, Cycles spp, Tesela spp)
 CASES = [
     ("packed_roughness_metallic", packed_rough_metal, 0, 256, 1024),
     ("normal_map_gentle_lambert", lambda: normal_map(0.02, (-0.3, 0.2, -1.0), 0.0), 0, 128, 512),
     ("normal_map_gentle_principled", lambda: normal_map(0.02, (-0.3, 0.2, -1.0)), 0, 128, 512),
     ("normal_map_metal_grazing_view", normal_map_glossy, 0, 128, 512),
+    pytest.param(("normal_map_glass_grazing_view", normal_map_glass, 2, 128, 512),
+                 marks=pytest.mark.xfail(reason=GLASS_NORMAL_MAP_REASON, strict=False)),
+    ("glass_tinted_ball", glass_tinted_ball, 6, 128, 512),
     ("normal_map_grazing_sun_lambert", lambda: normal_map(specular=0.0), 0, 128, 512),
     # Mapped normals up to 63 degrees off under a sun 15 degrees high: Cycles' bump shadowing
     # of the diffuse part, the raised normal of the specular part, and diffuse shading from

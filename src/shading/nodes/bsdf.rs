@@ -252,21 +252,23 @@ impl ClosureOp {
                     s.f(*roughness).clamp(0.0, 1.0),
                     s.f(*ior).clamp(1e-3, 1e3),
                 );
+                // Blender's Glass and Refraction tint every reflection and refraction by
+                // their colour: it is the closure's weight, as for Glossy.
                 let kind = if *refraction_only {
                     ClosureKind::Refraction {
-                        color,
+                        color: Vec3::ONE,
                         roughness,
                         ior,
                     }
                 } else {
                     ClosureKind::Glass {
-                        color,
+                        color: Vec3::ONE,
                         roughness,
                         ior,
                         multiscatter: *multiscatter,
                     }
                 };
-                push(out, Vec3::splat(w), normal(*n), Vec3::ZERO, kind);
+                push(out, color * w, normal(*n), Vec3::ZERO, kind);
             }
             ClosureParams::Translucent { color, normal: n } => push(
                 out,
