@@ -1,0 +1,211 @@
+"""tesela-farm on a local Dask cluster of 2 worker processes: a still split into sample ranges,
+a 4-frame sequence, a worker killed while its renderer runs, a failing renderer and an
+unreachable scheduler. Every image is compared with a render on this machine."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+FARM = REPO / "farm"
+# The workers are spawned processes: they inherit this path, so the package needs no install.
+if str(FARM) not in sys.path:
+    sys.path.insert(0, str(FARM))
+
+OpenEXR = pytest.importorskip("OpenEXR")
+try:
+    import distributed
+    import psutil
+except ImportError as exc:  # CI installs them (scripts/test.sh): a missing one is a failure there
+    if os.environ.get("CI", "").lower() in ("1", "true", "yes"):
+        raise
+    pytest.skip(f"dask.distributed is not installed ({exc})", allow_module_level=True)
+
+from tesela_farm import cli, farm  # noqa: E402
+
+SCENE = REPO / "scenes" / "cornell-box.gltf"
+SIZE = ["--width", "40", "--height", "32"]
+REL = 1e-5
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    c = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                 dashboard_address=None)
+    client = distributed.Client(c)
+    yield c, client
+    client.close()
+    c.close()
+
+
+def channels(path: Path) -> dict[str, np.ndarray]:
+    return {k: np.asarray(v.pixels, dtype=np.float64)
+            for k, v in OpenEXR.File(str(path)).channels().items()}
+
+
+def worst_relative_error(want: Path, got: Path) -> float:
+    """Largest per-pixel difference relative to the pixel's magnitude, over every layer."""
+    a, b = channels(want), channels(got)
+    assert a.keys() == b.keys()
+    worst = 0.0
+    for k in a:
+        x, y = a[k].reshape(a[k].shape[0], a[k].shape[1], -1), b[k].reshape(a[k].shape[0],
+                                                                            a[k].shape[1], -1)
+        err = np.abs(x - y).max(axis=2)
+        scale = np.maximum(np.abs(x), np.abs(y)).max(axis=2)
+        rel = np.where(err == 0, 0.0, err / np.where(scale == 0, 1.0, scale))
+        worst = max(worst, float(rel.max()))
+    return worst
+
+
+def local_render(tesela_bin, scene: Path, out: Path, *args: str) -> Path:
+    subprocess.run([str(tesela_bin), "render", str(scene), "-o", str(out), "--quiet", *args],
+                   check=True, stdin=subprocess.DEVNULL)
+    return out
+
+
+def test_still_in_sample_ranges_equals_the_local_render(cluster, tesela_bin, tmp_path, capsys):
+    c, _ = cluster
+    out = tmp_path / "farm.exr"
+    passes = "depth,normal,denoising_albedo"
+    rc = cli.main(["render", str(SCENE), "--scheduler", c.scheduler_address, "-o", str(out),
+                   "--spp", "24", "--parts", "5", "--passes", passes, "--tesela",
+                   str(tesela_bin), "--", *SIZE, "--threads", "1"])
+    err = capsys.readouterr().err
+    assert rc == 0, err
+    # Progress: one line per finished part.
+    assert err.count("done on tcp://") == 5, err
+    want = local_render(tesela_bin, SCENE, tmp_path / "local.exr", "--spp", "24", "--passes",
+                        passes, *SIZE)
+    e = worst_relative_error(want, out)
+    assert e <= REL, f"farm still differs from the local render by {e:.3g}"
+    # The comparison can fail: a render of other samples is far off.
+    other = local_render(tesela_bin, SCENE, tmp_path / "seed.exr", "--spp", "24", "--passes",
+                         passes, "--seed", "9", *SIZE)
+    assert worst_relative_error(other, out) > 0.01
+
+
+def _frames(tmp_path: Path, n: int) -> list[Path]:
+    """An animation exported one glTF per frame: the camera dollies in."""
+    doc = json.loads(SCENE.read_text())
+    cam = next(node for node in doc["nodes"] if "camera" in node)
+    paths = []
+    for f in range(n):
+        cam["matrix"][14] = 1.94 - 0.15 * f
+        p = tmp_path / f"shot_{f:02d}.gltf"
+        p.write_text(json.dumps(doc))
+        paths.append(p)
+    return paths
+
+
+def test_four_frames_one_task_each_equal_local_renders(cluster, tesela_bin, tmp_path, capsys):
+    c, client = cluster
+    scenes = _frames(tmp_path, 4)
+    rc = cli.main(["render", *map(str, scenes), "--frames", "--frame-start", "10",
+                   "--scheduler", c.scheduler_address, "-o", str(tmp_path / "out" / "f_###.exr"),
+                   "--spp", "8", "--tesela", str(tesela_bin), "--", *SIZE, "--threads", "1"])
+    err = capsys.readouterr().err
+    assert rc == 0, err
+    outs = [tmp_path / "out" / f"f_{10 + i:03d}.exr" for i in range(4)]
+    for scene, out in zip(scenes, outs):
+        want = local_render(tesela_bin, scene, tmp_path / f"{scene.stem}.exr", "--spp", "8",
+                            *SIZE)
+        e = worst_relative_error(want, out)
+        assert e <= REL, f"{out.name} differs from its local render by {e:.3g}"
+    # Frames are not interchangeable (a mix-up of outputs would fail above).
+    assert worst_relative_error(outs[0], outs[3]) > 0.01
+
+
+def test_a_failing_renderer_reports_its_message_and_status(cluster, tesela_bin, tmp_path,
+                                                           capsys):
+    c, _ = cluster
+    rc = cli.main(["render", str(SCENE), "--scheduler", c.scheduler_address, "-o",
+                   str(tmp_path / "x.exr"), "--spp", "4", "--tesela", str(tesela_bin), "--",
+                   *SIZE, "--integrator", "no_such_integrator"])
+    err = capsys.readouterr().err
+    assert rc == 1, err
+    assert "unknown integrator `no_such_integrator`" in err and "failed on tcp://" in err, err
+    assert not (tmp_path / "x.exr").exists()
+
+
+def test_unreachable_scheduler_is_a_clear_error(tesela_bin, tmp_path):
+    with socket.socket() as s:  # a port nothing listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    env = dict(os.environ, PYTHONPATH=str(FARM), TESELA_BIN=str(tesela_bin))
+    proc = subprocess.run(
+        [sys.executable, "-m", "tesela_farm", "render", str(SCENE), "--scheduler",
+         f"tcp://127.0.0.1:{port}", "--connect-timeout", "2", "-o", str(tmp_path / "x.exr")],
+        capture_output=True, text=True, env=env, timeout=120, stdin=subprocess.DEVNULL)
+    assert proc.returncode == 1, proc.stderr
+    assert f"cannot reach the Dask scheduler at tcp://127.0.0.1:{port}" in proc.stderr, proc.stderr
+
+
+def _running(p: psutil.Process) -> bool:
+    """Alive and not a zombie (a killed orphan waits as a zombie until its new parent reaps
+    it)."""
+    try:
+        return p.status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return False
+
+
+def _kill_a_worker_while_it_renders(client, killed: dict, stop: threading.Event):
+    """SIGKILLs the first worker process seen running a tesela child; records both pids."""
+    pids = client.run(os.getpid)
+    while not stop.is_set():
+        for pid in pids.values():
+            try:
+                kids = [k for k in psutil.Process(pid).children() if k.name() == "tesela"]
+            except psutil.NoSuchProcess:
+                continue
+            if kids:
+                os.kill(pid, signal.SIGKILL)
+                killed["worker"] = pid
+                # A part renders for seconds: a renderer still there a second later was left
+                # behind by its worker.
+                deadline = time.monotonic() + 1.0
+                while time.monotonic() < deadline and any(map(_running, kids)):
+                    time.sleep(0.02)
+                killed["left_behind"] = [k.pid for k in kids if _running(k)]
+                for k in kids:
+                    if _running(k):
+                        k.kill()
+                return
+        time.sleep(0.02)
+
+
+def test_a_worker_killed_mid_task_is_rescheduled_and_the_still_is_exact(cluster, tesela_bin,
+                                                                         tmp_path, capsys):
+    c, client = cluster
+    client.wait_for_workers(2)
+    out = tmp_path / "farm.exr"
+    args = ["--width", "64", "--height", "64", "--threads", "1"]
+    killed: dict = {}
+    stop = threading.Event()
+    killer = threading.Thread(target=_kill_a_worker_while_it_renders,
+                              args=(client, killed, stop))
+    killer.start()
+    try:
+        farm.render_still(client, SCENE, out, farm.Settings(tesela=str(tesela_bin),
+                                                            render_args=args),
+                          parts=4, spp=320)
+    finally:
+        stop.set()
+        killer.join()
+    assert "worker" in killed, "no worker was seen rendering"
+    assert killed["left_behind"] == [], "the renderer outlived its killed worker"
+    want = local_render(tesela_bin, SCENE, tmp_path / "local.exr", "--spp", "320", *args[:4])
+    e = worst_relative_error(want, out)
+    assert e <= REL, f"farm still after a killed worker differs by {e:.3g}"
