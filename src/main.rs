@@ -419,7 +419,9 @@ fn spawn_cancel_watchdog() {
             std::thread::sleep(Duration::from_millis(10));
         }
         std::thread::sleep(Duration::from_millis(250));
-        eprintln!("tesela: CANCELLED");
+        // Not eprintln!: it panics when stderr's reader is gone (a killed Blender), and this
+        // thread must reach the exit.
+        let _ = writeln!(std::io::stderr(), "tesela: CANCELLED");
         std::process::exit(EXIT_CANCELLED as i32);
     });
 }
@@ -790,7 +792,7 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(RenderError::Cancelled) => {
-            eprintln!("tesela: CANCELLED");
+            let _ = writeln!(std::io::stderr(), "tesela: CANCELLED");
             ExitCode::from(EXIT_CANCELLED)
         }
         Err(e) => {
