@@ -136,7 +136,11 @@ def main(argv: list[str] | None = None) -> int:
         argv, render_args = argv[:cut], argv[cut + 1:]
     a = _parser().parse_args(argv)
     # SIGTERM (a farm manager stopping the job) ends the run as Ctrl-C does: tasks cancelled.
-    signal.signal(signal.SIGTERM, signal.default_int_handler)
+    # The caller's handler comes back afterwards (main() may run inside another program).
+    try:
+        previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    except ValueError:  # not the main thread: signals stay as they are
+        previous = None
     try:
         _run_render(a, render_args)
     except farm.FarmError as exc:
@@ -148,6 +152,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("tesela-farm: cancelled", file=sys.stderr, flush=True)
         return farm.EXIT_CANCELLED
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
     return 0
 
 

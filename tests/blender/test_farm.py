@@ -60,8 +60,8 @@ def worst_relative_error(want: Path, got: Path) -> float:
     assert a.keys() == b.keys()
     worst = 0.0
     for k in a:
-        x, y = a[k].reshape(a[k].shape[0], a[k].shape[1], -1), b[k].reshape(a[k].shape[0],
-                                                                            a[k].shape[1], -1)
+        h, w = a[k].shape[:2]
+        x, y = a[k].reshape(h, w, -1), b[k].reshape(h, w, -1)
         err = np.abs(x - y).max(axis=2)
         scale = np.maximum(np.abs(x), np.abs(y)).max(axis=2)
         rel = np.where(err == 0, 0.0, err / np.where(scale == 0, 1.0, scale))
