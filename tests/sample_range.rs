@@ -194,3 +194,107 @@ fn adaptive_sampling_and_time_limits_are_not_split() {
     let e = render::render_range(&rs, &o, 8..30, &cancel, &|_, _, _| {}).unwrap_err();
     assert!(e.to_string().contains("8:30"), "{e}");
 }
+
+/// `tesela ARGS` run in `dir` → (exit status, stderr).
+fn tesela_in(dir: &std::path::Path, args: &[&str]) -> (i32, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_tesela"))
+        .args(args)
+        .current_dir(dir)
+        .stdin(std::process::Stdio::null())
+        .output()
+        .expect("run tesela");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn read_rgba(path: &std::path::Path) -> Vec<[f32; 4]> {
+    let img = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |r, _| vec![[0.0f32; 4]; r.width() * r.height()],
+        |px: &mut Vec<[f32; 4]>, p, (r, g, b, a): (f32, f32, f32, f32)| {
+            let w = 16;
+            px[p.y() * w + p.x()] = [r, g, b, a];
+        },
+    )
+    .unwrap();
+    img.layer_data.channel_data.pixels
+}
+
+#[test]
+fn the_command_line_splits_merges_and_refuses() {
+    let dir = std::env::temp_dir().join(format!("tesela-sample-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = |name: &str| dir.join(name).display().to_string();
+    let tesela = |args: &[&str]| tesela_in(&dir, args);
+    let base = [
+        "render",
+        "--builtin",
+        "cornell-box",
+        "--width",
+        "16",
+        "--height",
+        "16",
+    ];
+    fn with<'a>(base: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
+        [base, &["--spp", "12", "-q"], extra].concat()
+    }
+    assert_eq!(tesela(&with(&base, &["-o", &p("whole.exr")])).0, 0);
+    for (range, name) in [("0:5", "a.exr"), ("5:12", "b.exr")] {
+        let (code, err) = tesela(&with(
+            &base,
+            &["--sample-range", range, "--accumulators", &p(name)],
+        ));
+        assert_eq!(code, 0, "{err}");
+    }
+    // The sums are the result: no default tesela.png beside them.
+    assert!(!dir.join("tesela.png").exists());
+    let (code, err) = tesela(&["merge", &p("b.exr"), &p("a.exr"), "-o", &p("merged.exr")]);
+    assert_eq!(code, 0, "{err}");
+    let (want, got) = (
+        read_rgba(&dir.join("whole.exr")),
+        read_rgba(&dir.join("merged.exr")),
+    );
+    for (a, b) in want.iter().zip(&got) {
+        for (x, y) in a.iter().zip(b) {
+            assert!(
+                (x - y).abs() <= 1e-5 * x.abs().max(y.abs()),
+                "{a:?} vs {b:?}"
+            );
+        }
+    }
+    // A missing range, and what a part cannot have: usage errors (2) that say why.
+    let (code, err) = tesela(&["merge", &p("a.exr"), "-o", &p("m.exr")]);
+    assert!(code == 2 && err.contains("samples 5:12"), "{code} {err}");
+    let x = p("x.exr");
+    let part = |extra: &[&str]| {
+        let args = [
+            &["--sample-range", "0:4", "--accumulators", x.as_str()],
+            extra,
+        ]
+        .concat();
+        tesela(&with(&base, &args))
+    };
+    let (code, err) = part(&["--adaptive-threshold", "0.01"]);
+    assert!(
+        code == 2 && err.contains("adaptive sampling"),
+        "{code} {err}"
+    );
+    let (code, err) = part(&["--time-limit", "5"]);
+    assert!(code == 2 && err.contains("time limit"), "{code} {err}");
+    let (code, err) = part(&["--denoise"]);
+    assert!(
+        code == 2 && err.contains("tesela merge --denoise"),
+        "{code} {err}"
+    );
+    let (code, err) = tesela(&with(
+        &base,
+        &["--sample-range", "4:20", "--accumulators", &p("x.exr")],
+    ));
+    assert!(code == 2 && err.contains("4:20"), "{code} {err}");
+    // A plain image is not a part: the file is named, exit 3 (could not be loaded).
+    let (code, err) = tesela(&["merge", &p("whole.exr"), "-o", &p("m.exr")]);
+    assert!(code == 3 && err.contains("whole.exr"), "{code} {err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
