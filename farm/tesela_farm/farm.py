@@ -147,7 +147,7 @@ def render_still(client, scene: Path, output: Path, settings: Settings, parts: i
     if rendered:
         base += ["--passes", ",".join(rendered)]
     plan = jobs.split_samples(spp, parts)
-    tasks = [(f"part {p.index} (samples {p.range})", task_scene,
+    tasks = [(f"{scene.name} part {p.index} (samples {p.range})", task_scene,
               base + ["--sample-range", p.range, "--accumulators", "{out}"], "part.exr")
              for p in plan]
     with tempfile.TemporaryDirectory(prefix="tesela-farm-merge-") as tmp:

@@ -98,6 +98,9 @@ def render(scene: dict, args: list[str], output_name: str, tesela: str | None = 
             return result
         result["returncode"] = proc.returncode
         result["stderr"] = proc.stderr.decode("utf-8", "replace").strip()
+        if "path" not in scene:
+            # Name the scene's files as the user named them, not by this worker's temp folder.
+            result["stderr"] = result["stderr"].replace(str(tmp / "scene") + os.sep, "")
         if proc.returncode < 0:
             # Killed by a signal (a crash, or the machine's OOM killer): a failed render.
             result["returncode"] = EXIT_RENDER

@@ -137,6 +137,16 @@ def test_a_failing_renderer_reports_its_message_and_status(cluster, tesela_bin, 
     assert rc == 1, err
     assert "unknown integrator `no_such_integrator`" in err and "failed on tcp://" in err, err
     assert not (tmp_path / "x.exr").exists()
+    # A scene the renderer cannot load: its status (3), the file named as the user names it.
+    bad = tmp_path / "broken.gltf"
+    bad.write_text(json.dumps({"asset": {"version": "2.0"}, "nodes": [{"mesh": 0}],
+                               "meshes": [{"primitives": [{"attributes": {"POSITION": 7}}]}],
+                               "scenes": [{"nodes": [0]}]}))
+    rc = cli.main(["render", str(bad), "--scheduler", c.scheduler_address, "-o",
+                   str(tmp_path / "x.exr"), "--spp", "4", "--tesela", str(tesela_bin)])
+    err = capsys.readouterr().err
+    assert rc == 3, err
+    assert "tesela: error: broken.gltf: accessor 7" in err, err
 
 
 def test_unreachable_scheduler_is_a_clear_error(tesela_bin, tmp_path):
