@@ -87,12 +87,14 @@ def _run(client, tasks: Sequence[tuple[str, dict, list[str], str]], settings: Se
     """Submits `(label, scene, args, output name)` tasks, reports each as it finishes, and
     hands each result to `on_result(index, result)`. The first failure cancels the rest and
     raises FarmError with the renderer's message and exit status."""
-    from distributed import as_completed
+    from distributed import Event, as_completed
 
+    run = os.urandom(4).hex()
+    cancel = f"tesela-farm-cancel-{run}"
     futures = {}
     for i, (label, scene, args, out_name) in enumerate(tasks):
-        fut = client.submit(worker.render, scene, args, out_name, settings.tesela, pure=False,
-                            key=f"tesela-{label.replace(' ', '-')}-{os.urandom(4).hex()}")
+        fut = client.submit(worker.render, scene, args, out_name, settings.tesela, cancel,
+                            pure=False, key=f"tesela-{label.replace(' ', '-')}-{run}")
         futures[fut] = (i, label)
     settings.progress(f"{len(futures)} tasks submitted to {client.scheduler.address}")
     done = 0
@@ -113,6 +115,11 @@ def _run(client, tasks: Sequence[tuple[str, dict, list[str], str]], settings: Se
                               f"{result['seconds']:.2f} s")
             on_result(i, result)
     except BaseException:
+        # Dask cancels the tasks that wait; the event stops the renderers already running.
+        try:
+            Event(cancel, client=client).set()
+        except Exception:  # noqa: BLE001 - the scheduler may be gone: nothing more to stop
+            pass
         client.cancel(list(futures))
         raise
 

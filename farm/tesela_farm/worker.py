@@ -21,6 +21,9 @@ EXIT_RENDER = 1
 
 _PR_SET_PDEATHSIG = 1
 
+#: How often a running renderer's task looks at the run's cancel event.
+CANCEL_POLL_SECONDS = 0.5
+
 
 def find_tesela(explicit: str | None = None) -> str | None:
     """The renderer on this machine: `explicit`, else env TESELA_BIN, else `tesela` on PATH."""
@@ -60,13 +63,46 @@ def unpack(files: dict[str, bytes], into: Path) -> None:
         path.write_bytes(data)
 
 
-def render(scene: dict, args: list[str], output_name: str, tesela: str | None = None) -> dict:
+def _cancelled(event_name: str | None) -> bool:
+    """Whether the client set the run's cancel event (Dask cannot stop a running task)."""
+    if event_name is None:
+        return False
+    try:
+        from distributed import Event
+
+        return Event(event_name).is_set()
+    except (ImportError, ValueError, OSError):
+        return False
+
+
+def _run(cmd: list[str], cancel: str | None) -> tuple[int, bytes]:
+    """Runs the renderer to its end, or until the run is cancelled (then SIGTERM, which the
+    renderer answers by stopping at once). Returns (exit status, stderr)."""
+    proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, preexec_fn=_die_with_parent)
+    try:
+        while True:
+            try:
+                _, err = proc.communicate(timeout=CANCEL_POLL_SECONDS)
+                return proc.returncode, err
+            except subprocess.TimeoutExpired:
+                if _cancelled(cancel):
+                    proc.terminate()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+def render(scene: dict, args: list[str], output_name: str, tesela: str | None = None,
+           cancel: str | None = None) -> dict:
     """Renders `scene` with `tesela render SCENE ARGS`, writing `output_name` (a file name the
     args refer to as `{out}`), and returns `{"returncode", "stderr", "output", "host",
     "seconds"}` with the output file's bytes (None on failure).
 
     `scene` is `{"main": relative path of the scene file, "files": {relative path: bytes}}`
     (the scene travels with the task) or `{"path": a path every worker can read}`.
+    `cancel` names a Dask Event the client sets to stop the run's renderers.
     """
     started = time.monotonic()
     host = _worker_name()
@@ -91,22 +127,21 @@ def render(scene: dict, args: list[str], output_name: str, tesela: str | None = 
         cmd = [binary, "render", scene_path, "--quiet"]
         cmd += [str(out) if a == "{out}" else a for a in args]
         try:
-            proc = subprocess.run(cmd, stdin=subprocess.DEVNULL, capture_output=True,
-                                  preexec_fn=_die_with_parent, check=False)
+            returncode, stderr = _run(cmd, cancel)
         except OSError as exc:
             result["stderr"] = f"tesela-farm worker on {host}: cannot run {binary}: {exc}"
             return result
-        result["returncode"] = proc.returncode
-        result["stderr"] = proc.stderr.decode("utf-8", "replace").strip()
+        result["returncode"] = returncode
+        result["stderr"] = stderr.decode("utf-8", "replace").strip()
         if "path" not in scene:
             # Name the scene's files as the user named them, not by this worker's temp folder.
             result["stderr"] = result["stderr"].replace(str(tmp / "scene") + os.sep, "")
-        if proc.returncode < 0:
+        if returncode < 0:
             # Killed by a signal (a crash, or the machine's OOM killer): a failed render.
             result["returncode"] = EXIT_RENDER
             result["stderr"] += (f"\ntesela-farm worker on {host}: the renderer was killed "
-                                 f"by signal {-proc.returncode}")
-        if proc.returncode == 0:
+                                 f"by signal {-returncode}")
+        if returncode == 0:
             try:
                 result["output"] = out.read_bytes()
             except OSError as exc:

@@ -162,6 +162,54 @@ def test_unreachable_scheduler_is_a_clear_error(tesela_bin, tmp_path):
     assert f"cannot reach the Dask scheduler at tcp://127.0.0.1:{port}" in proc.stderr, proc.stderr
 
 
+def _renderers(client) -> list[psutil.Process]:
+    """The tesela processes the cluster's workers are running."""
+    found = []
+    for pid in client.run(os.getpid).values():
+        try:
+            found += [k for k in psutil.Process(pid).children() if k.name() == "tesela"]
+        except psutil.NoSuchProcess:
+            pass
+    return found
+
+
+def test_a_cancelled_farm_render_stops_the_running_renderers(cluster, tesela_bin, tmp_path):
+    """SIGTERM to tesela-farm (a user's Ctrl-C, or a job manager): exit status 130, and the
+    renderers already running on the workers stop (Dask itself cannot stop a running task)."""
+    c, client = cluster
+    client.wait_for_workers(2)
+    env = dict(os.environ, PYTHONPATH=str(FARM))
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "tesela_farm", "render", str(SCENE), "--scheduler",
+         c.scheduler_address, "-o", str(tmp_path / "x.exr"), "--spp", "1000000", "--parts", "2",
+         "--tesela", str(tesela_bin), "--", *SIZE, "--threads", "1"],
+        env=env, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+        text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while len(_renderers(client)) < 2 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        running = _renderers(client)
+        assert len(running) == 2, "the parts never started"
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130, err
+    assert "cancelled" in err, err
+    # Each task looks at the cancel event twice a second.
+    deadline = time.monotonic() + 10
+    while any(map(_running, running)) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    left = [r.pid for r in running if _running(r)]
+    for r in running:
+        if _running(r):
+            r.kill()
+    assert left == [], "renderers kept running after the farm render was cancelled"
+
+
 def _running(p: psutil.Process) -> bool:
     """Alive and not a zombie (a killed orphan waits as a zombie until its new parent reaps
     it)."""
