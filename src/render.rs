@@ -532,13 +532,13 @@ pub fn unsplittable(opts: &RenderOptions) -> Option<&'static str> {
     }
 }
 
-/// Renders samples `samples` of every pixel into the film's sums (rounds, adaptive
-/// sampling and the time limit only for a whole render, `0..opts.spp`).
+/// Renders samples `range` of every pixel into the film's sums (rounds, adaptive sampling
+/// and the time limit only for a whole render, `0..opts.spp`).
 fn render_film(
     scene: &RenderScene,
     opts: &RenderOptions,
     sampling: Sampling,
-    samples: Range<u32>,
+    range: Range<u32>,
     cancel: &AtomicBool,
     on_tile: &(dyn Fn(&Tile, usize, usize) + Sync),
 ) -> Result<(Accumulators, RenderStats), RenderError> {
@@ -561,7 +561,7 @@ fn render_film(
                 h: th,
                 px: vec![
                     PixelAcc {
-                        next: samples.start,
+                        next: range.start,
                         ..Default::default()
                     };
                     n
@@ -580,11 +580,11 @@ fn render_film(
     });
     let transparent = scene.scene.settings.film_transparent;
     let time_limit = opts.time_limit.filter(|t| *t > 0.0);
-    let whole = samples == (0..opts.spp);
+    let whole = range == (0..opts.spp);
     let ends = if whole {
         crate::film::round_ends(opts.spp, opts.adaptive.as_ref(), time_limit.is_some())
     } else {
-        vec![samples.end]
+        vec![range.end]
     };
     let threshold = opts.adaptive.map(|a| a.resolved(opts.spp).0);
     let total = tiles.len() * ends.len();
@@ -676,7 +676,7 @@ fn render_film(
     let mut film = Accumulators {
         width: rw,
         height: rh,
-        samples: samples.clone(),
+        samples: range.clone(),
         spp: opts.spp,
         passes: opts.passes.clone(),
         transparent,
@@ -684,7 +684,7 @@ fn render_film(
         pixels: vec![PixelAcc::default(); rw as usize * rh as usize],
         aovs: vec![0.0; rw as usize * rh as usize * stride],
     };
-    let first = samples.start;
+    let first = range.start;
     let (mut rays, mut rejected, mut samples) = (0u64, 0u64, 0u64);
     let (mut spp_min, mut spp_max, mut noise) = (u32::MAX, 0u32, 0.0f64);
     for t in &tiles {
