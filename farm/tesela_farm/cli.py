@@ -12,7 +12,7 @@ import signal
 import sys
 from pathlib import Path
 
-from . import farm, jobs
+from . import farm, jobs, worker
 
 _EPILOG = """\
 Arguments after `--` go to every `tesela render` (e.g. -- --width 640 --integrator path_mis).
@@ -111,6 +111,10 @@ def _run_render(a: argparse.Namespace, render_args: list[str]) -> None:
             if len({o.name for o in outputs}) != len(outputs):
                 raise farm.FarmError("--batch: two scenes have the same file name",
                                      farm.EXIT_USAGE)
+    if still and worker.find_tesela(a.tesela) is None:
+        # Before the cluster is reached or started: the parts could not be merged here.
+        raise farm.FarmError("no local tesela binary to merge the parts (set TESELA_BIN or "
+                             "pass --tesela)", farm.EXIT_USAGE)
     settings = farm.Settings(tesela=a.tesela, shared=a.shared, render_args=args)
     client, cluster = farm.connect(a.scheduler, a.local, a.connect_timeout)
     try:
