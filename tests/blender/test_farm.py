@@ -32,7 +32,7 @@ except ImportError as exc:  # CI installs them (scripts/test.sh): a missing one 
         raise
     pytest.skip(f"dask.distributed is not installed ({exc})", allow_module_level=True)
 
-from tesela_farm import cli, farm  # noqa: E402
+from tesela_farm import cli, farm, jobs  # noqa: E402
 
 SCENE = REPO / "scenes" / "cornell-box.gltf"
 SIZE = ["--width", "40", "--height", "32"]
@@ -47,6 +47,42 @@ def cluster():
     yield c, client
     client.close()
     c.close()
+
+
+def test_sample_ranges_tile_the_samples_and_frames_are_numbered():
+    for spp, parts in [(24, 5), (7, 7), (3, 8), (4096, 6)]:
+        plan = jobs.split_samples(spp, parts)
+        assert plan[0].start == 0 and plan[-1].end == spp
+        assert all(a.end == b.start for a, b in zip(plan, plan[1:]))
+        assert all(p.end > p.start for p in plan) and len(plan) == min(spp, parts)
+        sizes = [p.end - p.start for p in plan]
+        assert max(sizes) - min(sizes) <= 1
+    assert jobs.frame_output("out/f_####.exr", 7) == "out/f_0007.exr"
+    assert jobs.frame_output("a#/b_##.png", 123) == "a#/b_123.png"
+    with pytest.raises(ValueError):
+        jobs.frame_output("out/still.exr", 1)
+
+
+def test_a_scene_travels_with_its_buffers_and_images(tmp_path):
+    doc = {"asset": {"version": "2.0"}, "buffers": [{"uri": "data/mesh%20a.bin",
+                                                     "byteLength": 3}],
+           "images": [{"uri": "data:image/png;base64,AAAA"}, {"uri": "tex/wood.png"}],
+           "extensions": {"TESELA_render": {"spp": 96}}}
+    (tmp_path / "data").mkdir()
+    (tmp_path / "tex").mkdir()
+    (tmp_path / "data" / "mesh a.bin").write_bytes(b"abc")
+    (tmp_path / "tex" / "wood.png").write_bytes(b"png")
+    scene = tmp_path / "shot.gltf"
+    scene.write_text(json.dumps(doc))
+    b = jobs.bundle(scene)
+    assert b["main"] == "shot.gltf"
+    assert b["files"]["data/mesh a.bin"] == b"abc" and b["files"]["tex/wood.png"] == b"png"
+    assert len(b["files"]) == 3
+    assert jobs.scene_spp(scene) == 96
+    doc["images"][1]["uri"] = "../elsewhere.png"
+    scene.write_text(json.dumps(doc))
+    with pytest.raises(jobs.SceneError, match="outside the scene's folder.*--shared"):
+        jobs.bundle(scene)
 
 
 def channels(path: Path) -> dict[str, np.ndarray]:
