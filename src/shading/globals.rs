@@ -183,6 +183,24 @@ impl<'a> ShaderGlobals<'a> {
         })
     }
 
+    /// The linear part of the object → world map (object axes as the add-on wrote them, the
+    /// renderer's world axes), when on an object with an invertible transform.
+    #[inline]
+    pub fn object_to_world_linear(&self) -> Option<glam::Mat3> {
+        let a = glam::Mat3::from_mat4(self.to_object()?).inverse();
+        a.is_finite().then_some(a)
+    }
+
+    /// A world normal `n` (Blender axes) in object space, unit (Cycles'
+    /// `object_inverse_normal_transform`: the transposed object map); `n` off an object.
+    #[inline]
+    pub fn normal_to_object(&self, n: Vec3) -> Vec3 {
+        match self.object_to_world_linear() {
+            Some(a) => (a.transpose() * from_blender(n)).normalize_or_zero(),
+            None => n,
+        }
+    }
+
     /// Blender's Object Info of the point's object (the instance's own, if placed).
     #[inline]
     pub fn object_info(&self) -> Option<&'a ObjectInfo> {

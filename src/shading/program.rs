@@ -63,7 +63,7 @@ impl Op {
         match self {
             Op::Closure(op) => op.eval(s, g, out),
             Op::Input(op) => op.eval(s, g, env),
-            Op::Image(op) => op.eval(s, env),
+            Op::Image(op) => op.eval(s, g, env),
             Op::Vector(op) => op.eval(s, g),
             Op::Convert(op) => op.eval(s),
             Op::Texture(op) => op.eval(s),

@@ -264,6 +264,25 @@ def glass_tinted_ball():
     _sphere_stage(mat)
 
 
+def projected_image(projection, interpolation="Linear", coords="Object", blend=0.3):
+    """A checker image on a ball through the Image Texture's projection (box with a blend,
+    sphere or tube) from Object or Generated coordinates, into a Diffuse BSDF; Cubic reads a
+    small image, where it differs most from Linear."""
+    def build():
+        img = image("Proj", checker_px(8, 8, 2) if interpolation == "Cubic" else checker_px())
+        mat, nt, out = node_material("Projected")
+        tc = node(nt, "ShaderNodeTexCoord")
+        tex = image_node(nt, img, tc.outputs[coords], interpolation)
+        tex.projection = projection
+        if projection == "BOX":
+            tex.projection_blend = blend
+        surface(nt, out, node(nt, "ShaderNodeBsdfDiffuse", Color=tex.outputs["Color"]).outputs[0])
+        _sphere_stage(mat)
+        ball = bpy.data.objects["Ball"]
+        ball.rotation_euler = (0.3, -0.2, 0.7)  # the object's axes are not the world's
+    return build
+
+
 def noise_bump():
     """Bump (strength 0.8) from a Noise texture's Fac into a Principled BSDF, grazing sun."""
     mat, nt, out = node_material("NoiseBump")
@@ -556,6 +575,9 @@ CASES = [
     ("displacement_bump_noise", displacement_bump, 0, 128, 512),
     ("vector_displacement_ball", vector_displacement_ball, 0, 128, 512),
     ("displacement_wave_ball", lambda: vector_displacement_ball(False), 0, 128, 512),
+    ("image_box_projection", projected_image("BOX"), 0, 64, 256),
+    ("image_sphere_projection_cubic", projected_image("SPHERE", "Cubic", "Generated"), 0, 64, 256),
+    ("image_tube_projection", projected_image("TUBE", coords="Generated"), 0, 64, 256),
     ("mapping_scale_rotation", mapping_image, 0, 64, 256),
     ("mix_diffuse_glossy_layer_weight", mix_layer_weight, 0, 256, 1024),
     ("add_diffuse_glossy_fresnel", add_fresnel, 0, 256, 1024),

@@ -5,7 +5,7 @@
 //! whole surface graph (Cycles' `bump_from_displacement` and its Set Normal node).
 
 use crate::shading::compile::{CompileError, NodeCx, SocketType};
-use crate::shading::globals::{ShaderGlobals, from_blender, to_blender};
+use crate::shading::globals::{ShaderGlobals, to_blender};
 use crate::shading::program::{Slot, Slots};
 use glam::{Mat3, Vec3};
 
@@ -44,12 +44,9 @@ pub enum DisplacementOp {
     Normal { d: [Slot; 3], out: Slot },
 }
 
-/// The linear part of the object → world map in Blender's axes, when on an object.
 #[inline]
 fn object_to_world(g: &ShaderGlobals) -> Option<Mat3> {
-    let w = g.to_object()?;
-    let a = Mat3::from_mat4(w).inverse();
-    a.is_finite().then_some(a)
+    g.object_to_world_linear()
 }
 
 #[inline]
@@ -80,8 +77,7 @@ impl DisplacementOp {
                     (Space::Object, Some(a)) => {
                         // Cycles: the normal into object space (transposed map, normalised),
                         // scaled there, and back out through the object's transform.
-                        let n_obj = safe_normalize(a.transpose() * from_blender(n));
-                        to_blender(a * (n_obj * k))
+                        to_blender(a * (g.normal_to_object(n) * k))
                     }
                     _ => n * k,
                 };
