@@ -74,6 +74,7 @@ def renderer_args(binary, gltf, settings, width, height, region, pass_names=(), 
             "--seed", str(render_seed(settings, frame))]
     if settings.threads > 0:
         args += ["--threads", str(settings.threads)]
+    args += ["--tile-size", str(settings.tile_size)]
     if region is not None:
         args += ["--region"] + [str(v) for v in region]
     if pass_names:

@@ -29,6 +29,10 @@ class TeselaSceneSettings(bpy.types.PropertyGroup):
         description="Use a different seed for each frame (the seed plus the frame number)")
     threads: IntProperty(name="Threads", default=0, min=0, max=1024,
                          description="Render threads (0: all cores)")
+    tile_size: IntProperty(
+        name="Tile Size", default=32, min=8, max=4096, subtype="PIXEL",
+        description="Edge of the square tiles the image is rendered and shown in (smaller tiles "
+                    "appear sooner and balance threads better; larger ones cost less overhead)")
     diffuse_bounces: IntProperty(
         name="Diffuse", default=4, min=0, max=1024,
         description="Maximum number of diffuse reflection bounces, bounded by Max Depth")

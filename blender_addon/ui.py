@@ -88,6 +88,7 @@ class TESELA_PT_render(bpy.types.Panel):
         col.prop(s, "filter_width")
         col = layout.column(heading="Performance")
         col.prop(s, "threads")
+        col.prop(s, "tile_size")
         col = layout.column(heading="Debug")
         col.prop(s, "integrator")
         path, tried = preferences.find_renderer(context)
