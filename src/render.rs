@@ -5,6 +5,7 @@
 use crate::camera::RayCamera;
 use crate::film::data::{self, DataContext};
 use crate::film::{Adaptive, PassSet, PixelAcc};
+use crate::integrator::light_split::LightSplit;
 use crate::integrator::{self, Integrator};
 use crate::render_scene::{Ctx, RayQuery, RenderScene};
 use crate::sampler::SobolSampler;
@@ -321,6 +322,7 @@ fn render_samples(
     let transparent = scene.scene.settings.film_transparent;
     let lens = camera.has_lens();
     let adaptive = opts.adaptive.is_some();
+    let light = data.is_some_and(|d| d.passes.has_light());
     for s in acc.next..end {
         ctx.sampler = match sampling {
             Sampling::Sobol => SobolSampler::new(opts.seed, pixel_index, s as u64),
@@ -344,7 +346,12 @@ fn render_samples(
             continue;
         };
         ctx.camera_end = ray.tmax.is_finite().then(|| ray.o + ray.d * ray.tmax);
-        let l = integrator.li(scene, ctx, ray.o, ray.d);
+        let mut split = LightSplit::default();
+        let l = if light {
+            integrator.li_split(scene, ctx, ray.o, ray.d, &mut split)
+        } else {
+            integrator.li(scene, ctx, ray.o, ray.d)
+        };
         if l.is_finite() && l.min_element() >= 0.0 {
             acc.sum += l;
             acc.accepted += 1;
@@ -356,6 +363,9 @@ fn render_samples(
             }
             if let Some(data) = data {
                 data.add_sample(ctx, ray.o, ray.d, acc.accepted == 1, aov);
+                if light {
+                    data.add_light(&split, aov);
+                }
             }
         } else {
             *rejected += 1;
@@ -385,13 +395,18 @@ struct Prepared {
 /// Checks `opts` and sets up the integrator, the camera and the pixel window.
 fn prepare(scene: &RenderScene, opts: &RenderOptions) -> Result<Prepared, RenderError> {
     validate(opts)?;
+    let integrator =
+        integrator::by_name_with(&opts.integrator, opts.max_depth.max(1), opts.light_paths)
+            .ok_or_else(|| RenderError::Invalid("unknown integrator".into()))?;
+    if opts.passes.has_light() && !integrator.splits_light() {
+        return Err(RenderError::Invalid(format!(
+            "the light passes (diffuse/glossy/transmission direct and indirect) need the \
+             path_mis, path_mats or direct_mis integrator, not `{}`",
+            opts.integrator
+        )));
+    }
     Ok(Prepared {
-        integrator: integrator::by_name_with(
-            &opts.integrator,
-            opts.max_depth.max(1),
-            opts.light_paths,
-        )
-        .ok_or_else(|| RenderError::Invalid("unknown integrator".into()))?,
+        integrator,
         camera: RayCamera::new(&scene.scene, opts.width, opts.height),
         region: opts.region.unwrap_or([0, 0, opts.width, opts.height]),
     })
@@ -447,13 +462,20 @@ struct TileState {
 
 impl TileState {
     /// The tile as it stands now.
-    fn snapshot(&self, passes: &PassSet, transparent: bool, spp: u32) -> Tile {
-        let stride = passes.stride();
-        let mut aovs = vec![0.0; self.aov.len()];
+    /// The tile as it stands now, with the passes of `passes` from the sums laid out by
+    /// `acc` (`passes` and what they are computed from).
+    fn snapshot(&self, passes: &PassSet, acc: &PassSet, transparent: bool, spp: u32) -> Tile {
+        let (stride, acc_stride) = (passes.stride(), acc.stride());
+        let mut aovs = vec![0.0; self.px.len() * stride];
+        let noisy = passes.offset(crate::film::Pass::NoisyImage);
         if stride > 0 {
             for (i, p) in self.px.iter().enumerate() {
-                let r = i * stride..(i + 1) * stride;
-                data::resolve(passes, &self.aov[r.clone()], p.accepted, &mut aovs[r]);
+                let out = &mut aovs[i * stride..(i + 1) * stride];
+                let sums = &self.aov[i * acc_stride..(i + 1) * acc_stride];
+                data::resolve(acc, sums, p.accepted, passes, out);
+                if let Some(at) = noisy {
+                    out[at..at + 4].copy_from_slice(&p.rgba(transparent));
+                }
             }
         }
         Tile {
@@ -495,6 +517,9 @@ pub fn render_sampled(
     } = prepare(scene, opts)?;
     let ts = opts.tile_size.max(1);
     let stride = opts.passes.stride();
+    // The film's sums: the passes asked for and the Color passes their light passes need.
+    let acc_passes = opts.passes.with_dividers();
+    let acc_stride = acc_passes.stride();
     let mut tiles = Vec::new();
     for ty in (0..rh).step_by(ts as usize) {
         for tx in (0..rw).step_by(ts as usize) {
@@ -506,16 +531,16 @@ pub fn render_sampled(
                 w: tw,
                 h: th,
                 px: vec![PixelAcc::default(); n],
-                aov: vec![0.0; n * stride],
+                aov: vec![0.0; n * acc_stride],
                 rays: 0,
                 rejected: 0,
             });
         }
     }
-    let data_ctx = (!opts.passes.is_empty()).then_some(DataContext {
+    let data_ctx = (!acc_passes.is_empty()).then_some(DataContext {
         scene,
         camera: &camera,
-        passes: &opts.passes,
+        passes: &acc_passes,
         mist: scene.scene.settings.mist,
     });
     let transparent = scene.scene.settings.film_transparent;
@@ -563,7 +588,7 @@ pub fn render_sampled(
                             &mut ctx,
                             &mut rej,
                             acc,
-                            &mut t.aov[i * stride..(i + 1) * stride],
+                            &mut t.aov[i * acc_stride..(i + 1) * acc_stride],
                             sampling,
                         );
                     }
@@ -572,7 +597,11 @@ pub fn render_sampled(
                 t.rejected += rej;
                 let n = done.fetch_add(1, Ordering::Relaxed) + 1;
                 if stream && (worked || last) {
-                    on_tile(&t.snapshot(&opts.passes, transparent, end), n, total);
+                    on_tile(
+                        &t.snapshot(&opts.passes, &acc_passes, transparent, end),
+                        n,
+                        total,
+                    );
                 }
                 Ok(())
             })
@@ -601,7 +630,7 @@ pub fn render_sampled(
         for (i, t) in tiles.iter().enumerate() {
             let spp = t.px.iter().map(|p| p.next).max().unwrap_or(0);
             on_tile(
-                &t.snapshot(&opts.passes, transparent, spp),
+                &t.snapshot(&opts.passes, &acc_passes, transparent, spp),
                 total - n + i + 1,
                 total,
             );
@@ -618,7 +647,7 @@ pub fn render_sampled(
     let (mut rays, mut rejected, mut samples) = (0u64, 0u64, 0u64);
     let (mut spp_min, mut spp_max, mut noise) = (u32::MAX, 0u32, 0.0f64);
     for t in &tiles {
-        let snap = t.snapshot(&opts.passes, transparent, 0);
+        let snap = t.snapshot(&opts.passes, &acc_passes, transparent, 0);
         for y in 0..t.h {
             let src = &snap.pixels[(y * t.w) as usize..((y + 1) * t.w) as usize];
             let row = (t.y + y) as usize * rw as usize + t.x as usize;
