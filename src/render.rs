@@ -264,11 +264,18 @@ pub fn validate(opts: &RenderOptions) -> Result<(), RenderError> {
             "samples per pixel must be at least 1".into(),
         ));
     }
-    if integrator::by_name(&opts.integrator, 1).is_none() {
+    let Some(chosen) = integrator::by_name(&opts.integrator, 1) else {
         return Err(RenderError::Invalid(format!(
             "unknown integrator `{}` (choose one of {})",
             opts.integrator,
             integrator::NAMES.join(", ")
+        )));
+    };
+    if opts.passes.has_light() && !chosen.splits_light() {
+        return Err(RenderError::Invalid(format!(
+            "the light passes (diffuse/glossy/transmission direct and indirect) need the \
+             path_mis, path_mats or direct_mis integrator, not `{}`",
+            opts.integrator
         )));
     }
     if let Some(t) = opts.time_limit
@@ -398,13 +405,6 @@ fn prepare(scene: &RenderScene, opts: &RenderOptions) -> Result<Prepared, Render
     let integrator =
         integrator::by_name_with(&opts.integrator, opts.max_depth.max(1), opts.light_paths)
             .ok_or_else(|| RenderError::Invalid("unknown integrator".into()))?;
-    if opts.passes.has_light() && !integrator.splits_light() {
-        return Err(RenderError::Invalid(format!(
-            "the light passes (diffuse/glossy/transmission direct and indirect) need the \
-             path_mis, path_mats or direct_mis integrator, not `{}`",
-            opts.integrator
-        )));
-    }
     Ok(Prepared {
         integrator,
         camera: RayCamera::new(&scene.scene, opts.width, opts.height),
