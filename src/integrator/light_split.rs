@@ -112,7 +112,10 @@ impl Sink for LightSplit {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bsdf::{Diffuse, Plastic};
+    use crate::bsdf::{Diffuse, Plastic, from_closure};
+    use crate::sampler::Sampler;
+    use crate::sampling::square_to_uniform_sphere;
+    use crate::shading::{Closure, ClosureKind, Principled};
 
     #[test]
     fn weights_split_a_mixed_lobe_and_sum_to_one() {
@@ -137,5 +140,136 @@ mod tests {
         s.bounced(Vec3::ONE, &ClassWeights::default(), false);
         assert!((s.total() - Vec3::splat(3.0)).abs().max_element() < 1e-5);
         assert_eq!(s.indirect[2], Vec3::ONE);
+    }
+
+    fn principled(metallic: f32, transmission: f32, coat: f32, sheen: f32) -> Principled {
+        Principled {
+            base_color: Vec3::new(0.7, 0.4, 0.2),
+            metallic,
+            roughness: 0.4,
+            ior: 1.45,
+            specular_level: 0.5,
+            specular_tint: Vec3::ONE,
+            transmission,
+            anisotropic: 0.0,
+            anisotropic_rotation: 0.0,
+            coat_weight: coat,
+            coat_roughness: 0.2,
+            coat_ior: 1.5,
+            coat_tint: Vec3::ONE,
+            coat_normal: Vec3::ZERO,
+            sheen_weight: sheen,
+            sheen_roughness: 0.5,
+            sheen_tint: Vec3::ONE,
+            subsurface_weight: 0.0,
+            subsurface_radius: Vec3::ONE,
+            subsurface_scale: 0.0,
+            cycles: true,
+        }
+    }
+
+    /// Over random direction pairs, every BSDF's diffuse and glossy parts are non-negative and
+    /// at most its value; on the reflection side of an opaque BSDF they are all of it; a
+    /// dielectric's refraction is neither (transmission).
+    #[test]
+    fn splits_are_parts_of_the_value() {
+        let color = Vec3::new(0.8, 0.5, 0.3);
+        let kinds = [
+            (
+                ClosureKind::Principled(principled(0.0, 0.0, 0.0, 0.0)),
+                "plastic",
+            ),
+            (
+                ClosureKind::Principled(principled(0.0, 0.0, 0.6, 0.8)),
+                "sheen+coat",
+            ),
+            (
+                ClosureKind::Principled(principled(1.0, 0.0, 0.5, 0.0)),
+                "coated metal",
+            ),
+            (
+                ClosureKind::Principled(principled(0.0, 1.0, 0.0, 0.0)),
+                "glass",
+            ),
+            (
+                ClosureKind::Glass {
+                    color,
+                    roughness: 0.3,
+                    ior: 1.5,
+                    multiscatter: true,
+                },
+                "glass bsdf",
+            ),
+            (
+                ClosureKind::Glossy {
+                    color,
+                    roughness: 0.3,
+                    anisotropy: 0.0,
+                    rotation: 0.0,
+                    multiscatter: true,
+                },
+                "glossy",
+            ),
+            (ClosureKind::Translucent { color }, "translucent"),
+            (ClosureKind::Diffuse { color }, "diffuse"),
+        ];
+        let mut rng = Sampler::new(5, 0, 0);
+        for (kind, name) in kinds {
+            let (mut reflected, mut refracted) = (0, 0);
+            for i in 0..4000 {
+                let c = Closure {
+                    weight: Vec3::ONE,
+                    normal: Vec3::ZERO,
+                    tangent: Vec3::ZERO,
+                    kind,
+                };
+                let b = from_closure(&c, (i as f32 + 0.5) / 4000.0);
+                let mut wi = square_to_uniform_sphere(rng.next_2d());
+                wi.z = wi.z.abs().max(0.05);
+                let wi = wi.normalize();
+                let wo = square_to_uniform_sphere(rng.next_2d());
+                let rec = BsdfQueryRecord::pair(wi, wo);
+                let f = b.eval(&rec);
+                let [d, g] = b.eval_split(&rec);
+                let tol = 1e-4 * f.max_element() + 1e-7;
+                assert!(d.min_element() >= 0.0 && g.min_element() >= 0.0, "{name}");
+                assert!(
+                    ((d + g) - f).max_element() <= tol,
+                    "{name}: {d} + {g} > {f}"
+                );
+                if f.max_element() > 0.0 {
+                    if wo.z > 0.0 {
+                        reflected += 1;
+                        assert!((f - (d + g)).abs().max_element() <= tol, "{name}");
+                    } else {
+                        refracted += 1;
+                        if !name.contains("translucent") {
+                            assert_eq!(d + g, Vec3::ZERO, "{name}: refraction is transmission");
+                        } else {
+                            assert_eq!(d, f, "{name}: translucent is diffuse");
+                        }
+                    }
+                }
+            }
+            if !name.contains("translucent") {
+                assert!(reflected > 100, "{name}: {reflected} reflections tested");
+            }
+            if name.contains("glass") || name.contains("translucent") {
+                assert!(refracted > 100, "{name}: {refracted} refractions tested");
+            }
+        }
+        // Sheen is diffuse, the coat glossy: a sheen over a plain diffuse base is all diffuse.
+        let mut p = principled(0.0, 0.0, 0.0, 1.0);
+        p.specular_level = 0.0;
+        let c = Closure {
+            weight: Vec3::ONE,
+            normal: Vec3::ZERO,
+            tangent: Vec3::ZERO,
+            kind: ClosureKind::Principled(p),
+        };
+        let rec = BsdfQueryRecord::pair(Vec3::new(0.6, 0.0, 0.8), Vec3::new(-0.3, 0.2, 0.93));
+        let b = from_closure(&c, 0.9);
+        let [d, g] = b.eval_split(&rec);
+        assert!(g == Vec3::ZERO && (d - b.eval(&rec)).abs().max_element() < 1e-6);
     }
 }
