@@ -1,8 +1,8 @@
 """Cycles' light passes through the add-on against Cycles' own (bpy 5).
 
 The Cornell box (Lambertian walls, an emissive ceiling quad) with a rough metal sphere
-(glossy), a rough glass sphere (glossy reflection and transmission) and a blue dielectric ball
-(Principled with its specular layer: diffuse and glossy in one closure); View Layer > Passes:
+(glossy), a rough glass sphere (glossy reflection and transmission) and a ball mixing a
+Diffuse and a Glossy BSDF (two classes in one material); View Layer > Passes:
 every Diffuse, Glossy and Transmission pass. Both renders are multi-layer EXRs read back.
 
 Criteria: the Color passes with the agreement thresholds (means within 2%, 8x8-block p95
@@ -55,6 +55,27 @@ def addon():
         blender_addon.unregister()
 
 
+def diffuse_and_glossy():
+    """Two closures in one material: Mix Shader (0.35) of a blue Diffuse BSDF and a rough
+    white Glossy BSDF."""
+    mat = bpy.data.materials.new("Ball")
+    mat.use_nodes = True
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    nodes.clear()
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (0.2, 0.35, 0.8, 1.0)
+    # Blender 4.0 merged Anisotropic into Glossy under the older node's idname.
+    glossy = nodes.new("ShaderNodeBsdfAnisotropic")
+    glossy.inputs["Roughness"].default_value = 0.3
+    mix = nodes.new("ShaderNodeMixShader")
+    mix.inputs["Fac"].default_value = 0.35
+    out = nodes.new("ShaderNodeOutputMaterial")
+    links.new(diffuse.outputs[0], mix.inputs[1])
+    links.new(glossy.outputs[0], mix.inputs[2])
+    links.new(mix.outputs[0], out.inputs["Surface"])
+    return mat
+
+
 def build_scene():
     info = scenes.cornell_box(spheres=True)
     metal = bpy.data.materials["Mirror"]
@@ -67,8 +88,7 @@ def build_scene():
     glass = bpy.data.materials["Glass"]
     bsdf = next(n for n in glass.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
     bsdf.inputs["Roughness"].default_value = 0.25
-    ball = scenes.material("Ball", base_color=(0.2, 0.35, 0.8), roughness=0.35, specular=0.5)
-    scenes.add_sphere("Ball", (0.35, 0.5, 0.25), 0.25, ball)
+    scenes.add_sphere("Ball", (-0.05, -0.6, 0.2), 0.2, diffuse_and_glossy())
     vl = info.scene.view_layers[0]
     for toggle in TOGGLES:
         setattr(vl, toggle, True)
