@@ -390,8 +390,7 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
         if left_out:
             message = "Tesela does not render these passes yet (left empty): " + ", ".join(left_out)
             if not passes.splits_light(settings):
-                message += (" (the light passes need the path_mis, path_mats or direct_mis "
-                            "integrator)")
+                message += " (the %s view has no light passes)" % settings.integrator
             print("Tesela: " + message)
             self.report({"WARNING"}, "Tesela: " + message)
 

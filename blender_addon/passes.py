@@ -27,7 +27,8 @@ PASSES = (
 # The Direct and Indirect light passes: only the integrators that split their light have them.
 LIGHT = ("diffuse_direct", "diffuse_indirect", "glossy_direct", "glossy_indirect",
          "transmission_direct", "transmission_indirect")
-SPLITTING_INTEGRATORS = ("path_mis", "path_mats", "direct_mis")
+# The debug views have no light to split.
+NO_LIGHT_SPLIT = ("normals", "albedo")
 # Combined before denoising, registered as Cycles does when the view layer is denoised.
 NOISY = ("noisy_image", "Noisy Image", "RGBA", "COLOR")
 DENOISING = (
@@ -55,7 +56,7 @@ def store_denoising_data(view_layer, settings):
 
 def splits_light(settings):
     """True when the chosen integrator renders the Direct and Indirect light passes."""
-    return getattr(settings, "integrator", "path_mis") in SPLITTING_INTEGRATORS
+    return getattr(settings, "integrator", "path_mis") not in NO_LIGHT_SPLIT
 
 
 def denoised(view_layer, settings):

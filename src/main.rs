@@ -128,8 +128,8 @@ struct RenderArgs {
     /// material_index, emission, environment, denoising_normal, denoising_albedo,
     /// diffuse_direct, diffuse_indirect, diffuse_color, glossy_direct, glossy_indirect,
     /// glossy_color, transmission_direct, transmission_indirect, transmission_color (direct
-    /// and indirect divided by colour, as Cycles shows them; they need path_mis, path_mats or
-    /// direct_mis), noisy_image (Combined before --denoise) (Cycles' passes of those names).
+    /// and indirect divided by colour, as Cycles shows them; not with the normals and albedo
+    /// views), noisy_image (Combined before --denoise) (Cycles' passes of those names).
     /// An .exr output becomes multi-layer with Blender's layer and
     /// channel names (ViewLayer.Depth.Z, ...); with --pipe they travel in the tiles
     /// (protocol version 2).

@@ -273,8 +273,9 @@ pub fn validate(opts: &RenderOptions) -> Result<(), RenderError> {
     };
     if opts.passes.has_light() && !chosen.splits_light() {
         return Err(RenderError::Invalid(format!(
-            "the light passes (diffuse/glossy/transmission direct and indirect) need the \
-             path_mis, path_mats or direct_mis integrator, not `{}`",
+            "the light passes (diffuse/glossy/transmission direct and indirect) need a \
+             shading integrator (path_mis, path_mats, direct_mis, direct_ems, direct_mats), \
+             not `{}`",
             opts.integrator
         )));
     }

@@ -51,7 +51,13 @@ fn mean(img: &Image, p: Pass) -> f64 {
 fn light_passes_add_up_to_combined_on_every_pixel() {
     // Diffuse walls, a mirror and a glass sphere, an area light.
     let rs = scene("cornell-spheres");
-    for integrator in ["path_mis", "path_mats", "direct_mis"] {
+    for integrator in [
+        "path_mis",
+        "path_mats",
+        "direct_mis",
+        "direct_ems",
+        "direct_mats",
+    ] {
         let img = run(&rs, &opts(32, 16, integrator));
         let (emit, env) = (rgb(&img, Pass::Emission), rgb(&img, Pass::Environment));
         let classes: Vec<_> = LightClass::ALL
@@ -100,7 +106,13 @@ fn each_class_gets_its_light() {
 fn a_direct_integrator_has_no_indirect_light() {
     // The plain box: diffuse walls only (no delta chain leads to a later vertex).
     let rs = scene("cornell-box");
-    for (integrator, depth) in [("direct_mis", 2), ("path_mis", 2), ("path_mats", 2)] {
+    for (integrator, depth) in [
+        ("direct_mis", 2),
+        ("direct_ems", 2),
+        ("direct_mats", 2),
+        ("path_mis", 2),
+        ("path_mats", 2),
+    ] {
         let mut o = opts(24, 8, integrator);
         o.max_depth = depth;
         let img = run(&rs, &o);

@@ -32,7 +32,10 @@ pub enum Pass {
     /// [`crate::bsdf::Bsdf::eval_split`]), *divided by the pass's colour* as Cycles shows it.
     /// Direct is light sampled at the first bounce and emission met by the ray leaving it;
     /// Indirect all that comes later. So `(Direct + Indirect) · Color` of the three classes,
-    /// plus Emission and Environment, is Combined.
+    /// plus Emission and Environment, is Combined: per pixel where the camera sees opaque
+    /// surfaces, in expectation through partly transparent ones (Emission and Environment
+    /// weight what lies behind by the transparency, a path picks it at random) or with
+    /// clamping (which Emission and Environment do not apply).
     DiffuseDirect,
     DiffuseIndirect,
     /// The summed albedo of the diffuse closures (Cycles' `bsdf_albedo`) where the camera
