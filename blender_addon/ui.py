@@ -60,6 +60,11 @@ class TESELA_PT_render(bpy.types.Panel):
         sub.active = s.use_adaptive_sampling
         sub.prop(s, "adaptive_min_samples")
         col.prop(s, "time_limit")
+        col = layout.column(heading="Viewport")
+        col.prop(s, "preview_samples", text="Samples")
+        col.prop(s, "preview_start_resolution")
+        col.prop(context.scene.render, "preview_pixel_size", text="Pixel Size")
+        col.prop(s, "use_preview_denoising")
         row = col.row(align=True)
         row.prop(s, "seed")
         row.prop(s, "use_animated_seed", text="", icon="TIME")

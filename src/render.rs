@@ -3,6 +3,7 @@
 //! thread count. Non-finite samples are rejected (counted, never written to the film).
 
 use crate::camera::RayCamera;
+use crate::film::accumulators::Accumulators;
 use crate::film::data::{self, DataContext};
 use crate::film::{Adaptive, PassSet, PixelAcc};
 use crate::integrator::light_split::LightSplit;
@@ -11,6 +12,7 @@ use crate::render_scene::{Ctx, RayQuery, RenderScene};
 use crate::sampler::SobolSampler;
 use glam::Vec2;
 use rayon::prelude::*;
+use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
@@ -511,13 +513,67 @@ pub fn render_sampled(
     cancel: &AtomicBool,
     on_tile: &(dyn Fn(&Tile, usize, usize) + Sync),
 ) -> Result<(Image, RenderStats), RenderError> {
+    let (film, stats) = render_film(scene, opts, sampling, 0..opts.spp, cancel, on_tile)?;
+    let mut image = film.resolve();
+    // The film also summed the Color passes its light passes are divided by.
+    image.retain_passes(&opts.passes);
+    Ok((image, stats))
+}
+
+/// Renders samples `samples` (`[start, end)`, within `[0, opts.spp)`) of every pixel with the
+/// streams a whole render gives them, and returns the film's sums: the parts of a render
+/// split by sample range merge into it exactly ([`Accumulators::merge`]). Adaptive sampling
+/// and a time limit decide which samples exist from the whole film, so a part cannot have
+/// them. The returned key is empty: the caller names the render.
+pub fn render_range(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    samples: Range<u32>,
+    cancel: &AtomicBool,
+    on_tile: &(dyn Fn(&Tile, usize, usize) + Sync),
+) -> Result<(Accumulators, RenderStats), RenderError> {
+    if samples.start >= samples.end || samples.end > opts.spp {
+        return Err(RenderError::Invalid(format!(
+            "sample range {}:{} is empty or outside the render's {} samples",
+            samples.start, samples.end, opts.spp
+        )));
+    }
+    if let Some(why) = unsplittable(opts) {
+        return Err(RenderError::Invalid(format!(
+            "{why} cannot be split into sample ranges exactly"
+        )));
+    }
+    render_film(scene, opts, Sampling::Sobol, samples, cancel, on_tile)
+}
+
+/// What in `opts` makes a render's samples depend on the whole film (so a sample range
+/// cannot be rendered alone).
+pub fn unsplittable(opts: &RenderOptions) -> Option<&'static str> {
+    if opts.adaptive.is_some() {
+        Some("adaptive sampling (each pixel's sample count depends on the whole film)")
+    } else if opts.time_limit.is_some_and(|t| t > 0.0) {
+        Some("a time limit (the sample count depends on the machine's speed)")
+    } else {
+        None
+    }
+}
+
+/// Renders samples `range` of every pixel into the film's sums (rounds, adaptive sampling
+/// and the time limit only for a whole render, `0..opts.spp`).
+fn render_film(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    sampling: Sampling,
+    range: Range<u32>,
+    cancel: &AtomicBool,
+    on_tile: &(dyn Fn(&Tile, usize, usize) + Sync),
+) -> Result<(Accumulators, RenderStats), RenderError> {
     let Prepared {
         integrator,
         camera,
         region: [rx, ry, rw, rh],
     } = prepare(scene, opts)?;
     let ts = opts.tile_size.max(1);
-    let stride = opts.passes.stride();
     // The film's sums: the passes asked for and the Color passes their light passes need.
     let acc_passes = opts.passes.with_dividers();
     let acc_stride = acc_passes.stride();
@@ -531,7 +587,13 @@ pub fn render_sampled(
                 y: ty,
                 w: tw,
                 h: th,
-                px: vec![PixelAcc::default(); n],
+                px: vec![
+                    PixelAcc {
+                        next: range.start,
+                        ..Default::default()
+                    };
+                    n
+                ],
                 aov: vec![0.0; n * acc_stride],
                 rays: 0,
                 rejected: 0,
@@ -546,7 +608,12 @@ pub fn render_sampled(
     });
     let transparent = scene.scene.settings.film_transparent;
     let time_limit = opts.time_limit.filter(|t| *t > 0.0);
-    let ends = crate::film::round_ends(opts.spp, opts.adaptive.as_ref(), time_limit.is_some());
+    let whole = range == (0..opts.spp);
+    let ends = if whole {
+        crate::film::round_ends(opts.spp, opts.adaptive.as_ref(), time_limit.is_some())
+    } else {
+        vec![range.end]
+    };
     let threshold = opts.adaptive.map(|a| a.resolved(opts.spp).0);
     let total = tiles.len() * ends.len();
     let done = AtomicUsize::new(0);
@@ -638,28 +705,33 @@ pub fn render_sampled(
         }
     }
 
-    let mut image = Image {
+    let mut film = Accumulators {
         width: rw,
         height: rh,
-        pixels: vec![[0.0; 4]; rw as usize * rh as usize],
-        passes: opts.passes.clone(),
-        aovs: vec![0.0; rw as usize * rh as usize * stride],
+        samples: range.clone(),
+        spp: opts.spp,
+        passes: acc_passes.clone(),
+        transparent,
+        key: String::new(),
+        pixels: vec![PixelAcc::default(); rw as usize * rh as usize],
+        aovs: vec![0.0; rw as usize * rh as usize * acc_stride],
     };
+    let first = range.start;
     let (mut rays, mut rejected, mut samples) = (0u64, 0u64, 0u64);
     let (mut spp_min, mut spp_max, mut noise) = (u32::MAX, 0u32, 0.0f64);
     for t in &tiles {
-        let snap = t.snapshot(&opts.passes, &acc_passes, transparent, 0);
         for y in 0..t.h {
-            let src = &snap.pixels[(y * t.w) as usize..((y + 1) * t.w) as usize];
+            let src = (y * t.w) as usize..((y + 1) * t.w) as usize;
             let row = (t.y + y) as usize * rw as usize + t.x as usize;
-            image.pixels[row..row + t.w as usize].copy_from_slice(src);
-            let a = (y * t.w) as usize * stride..((y + 1) * t.w) as usize * stride;
-            image.aovs[row * stride..(row + t.w as usize) * stride].copy_from_slice(&snap.aovs[a]);
+            film.pixels[row..row + t.w as usize].copy_from_slice(&t.px[src.clone()]);
+            film.aovs[row * acc_stride..(row + t.w as usize) * acc_stride]
+                .copy_from_slice(&t.aov[src.start * acc_stride..src.end * acc_stride]);
         }
         for p in &t.px {
-            samples += p.next as u64;
-            spp_min = spp_min.min(p.next);
-            spp_max = spp_max.max(p.next);
+            let n = p.next - first;
+            samples += n as u64;
+            spp_min = spp_min.min(n);
+            spp_max = spp_max.max(n);
             let e = p.error() as f64;
             if e.is_finite() {
                 noise += e;
@@ -671,7 +743,7 @@ pub fn render_sampled(
     let pixels = (rw as u64 * rh as u64).max(1);
     let seconds = start.elapsed().as_secs_f64();
     Ok((
-        image,
+        film,
         RenderStats {
             seconds,
             samples,

@@ -211,6 +211,12 @@ impl<T: Layer, B: Bsdf> Layered<T, B> {
         Layered { top, base }
     }
 
+    /// The probability with which `sample` picks the top lobe for `wi`.
+    #[inline]
+    pub fn top_probability(&self, wi: Vec3) -> f32 {
+        self.split(wi).0
+    }
+
     /// `(probability of sampling the top, A(wi))`.
     #[inline]
     fn split(&self, wi: Vec3) -> (f32, Vec3) {

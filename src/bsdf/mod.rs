@@ -172,6 +172,21 @@ impl BsdfInstance {
             _ => false,
         }
     }
+
+    /// A glossy layer over a diffuse base evaluated as its two parts, `(diffuse, glossy)` per
+    /// steradian (their sum is `eval`), for the corrections Cycles applies to its diffuse
+    /// closures alone; `None` for BSDFs that are not such a pair.
+    #[inline]
+    pub fn diffuse_parts(&self, rec: &BsdfQueryRecord) -> Option<(Vec3, Vec3)> {
+        match self {
+            BsdfInstance::Plastic(p) => Some(p.eval_parts(rec)),
+            BsdfInstance::Layered(l) if matches!(l.base, BaseLobe::Diffuse(_)) => {
+                let att = layered::Layer::attenuation(&l.top, rec.wi);
+                Some((att * l.base.eval(rec), l.top.eval(rec)))
+            }
+            _ => None,
+        }
+    }
 }
 
 /// Below this GGX alpha a lobe is treated as a perfect (delta) reflection.

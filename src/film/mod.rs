@@ -4,6 +4,7 @@
 //! Every pixel keeps its own sums, added in sample order, so a render is the same for any
 //! thread count and any split into rounds (Combined is bit-identical to one long round).
 
+pub mod accumulators;
 pub mod color;
 pub mod data;
 pub mod filter;

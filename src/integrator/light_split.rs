@@ -221,6 +221,7 @@ mod tests {
                     weight: Vec3::ONE,
                     normal: Vec3::ZERO,
                     tangent: Vec3::ZERO,
+                    surface_normal: Vec3::ZERO,
                     kind,
                 };
                 let b = from_closure(&c, (i as f32 + 0.5) / 4000.0);
@@ -265,6 +266,7 @@ mod tests {
             weight: Vec3::ONE,
             normal: Vec3::ZERO,
             tangent: Vec3::ZERO,
+            surface_normal: Vec3::ZERO,
             kind: ClosureKind::Principled(p),
         };
         let rec = BsdfQueryRecord::pair(Vec3::new(0.6, 0.0, 0.8), Vec3::new(-0.3, 0.2, 0.93));

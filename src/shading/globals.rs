@@ -46,6 +46,8 @@ pub struct ShaderGlobals<'a> {
     pub p: Vec3,
     /// Unit shading normal, flipped to the side the ray came from (Cycles' `N`).
     pub n: Vec3,
+    /// `n` is no longer the interpolated normal: a displacement rendered as bump replaced it.
+    pub n_displaced: bool,
     /// Unit geometric normal, on the same side as `n`.
     pub ng: Vec3,
     /// Unit direction from the point towards the ray's origin (Cycles' `I`).
@@ -78,6 +80,7 @@ impl<'a> ShaderGlobals<'a> {
         ShaderGlobals {
             p,
             n,
+            n_displaced: false,
             ng: n,
             i: n,
             backfacing: false,
