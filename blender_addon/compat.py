@@ -229,7 +229,12 @@ def pass_rect_set(render_pass, flat_rgba):
 
 # Blender 4.2 renamed the short render pass names Cycles registers (IndexOB -> Object Index).
 _PASS_NAMES_4_2 = {"IndexOB": "Object Index", "IndexMA": "Material Index", "Emit": "Emission",
-                   "Env": "Environment"}
+                   "Env": "Environment",
+                   "DiffDir": "Diffuse Direct", "DiffInd": "Diffuse Indirect",
+                   "DiffCol": "Diffuse Color", "GlossDir": "Glossy Direct",
+                   "GlossInd": "Glossy Indirect", "GlossCol": "Glossy Color",
+                   "TransDir": "Transmission Direct", "TransInd": "Transmission Indirect",
+                   "TransCol": "Transmission Color"}
 
 
 def pass_name(name):

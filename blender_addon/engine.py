@@ -312,9 +312,11 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
                 continue
             pass_names.append(name)
             pass_targets[bname] = (rp, np.zeros((rh, rw, len(ids)), dtype=np.float32))
-        left_out = passes.unsupported(depsgraph.view_layer)
+        left_out = [compat.pass_name(n) for n in passes.unsupported(depsgraph.view_layer, settings)]
         if left_out:
             message = "Tesela does not render these passes yet (left empty): " + ", ".join(left_out)
+            if not passes.splits_light(settings):
+                message += " (the %s view has no light passes)" % settings.integrator
             print("Tesela: " + message)
             self.report({"WARNING"}, "Tesela: " + message)
 

@@ -128,8 +128,12 @@ struct RenderArgs {
     #[arg(long, value_name = "DEG", requires = "env", allow_hyphen_values = true)]
     env_rotation: Option<f32>,
     /// Auxiliary passes, comma-separated: depth, mist, normal, position, uv, object_index,
-    /// material_index, emission, environment, denoising_normal, denoising_albedo (Cycles'
-    /// passes of those names). An .exr output becomes multi-layer with Blender's layer and
+    /// material_index, emission, environment, denoising_normal, denoising_albedo,
+    /// diffuse_direct, diffuse_indirect, diffuse_color, glossy_direct, glossy_indirect,
+    /// glossy_color, transmission_direct, transmission_indirect, transmission_color (direct
+    /// and indirect divided by colour, as Cycles shows them; not with the normals and albedo
+    /// views), noisy_image (Combined before --denoise) (Cycles' passes of those names).
+    /// An .exr output becomes multi-layer with Blender's layer and
     /// channel names (ViewLayer.Depth.Z, ...); with --pipe they travel in the tiles
     /// (protocol version 2).
     #[arg(long, value_delimiter = ',', value_name = "LIST")]
@@ -913,7 +917,10 @@ fn run_render(args: &RenderArgs) -> ExitCode {
         Some(r) => render::render_range(&rscene, &opts, r.clone(), &CANCEL, &on_tile).map(
             |(mut film, s)| {
                 film.key = key.clone().unwrap_or_default();
-                (film.resolve(), s, Some(film))
+                let mut image = film.resolve();
+                // The film also summed the Color passes its light passes are divided by.
+                image.retain_passes(&opts.passes);
+                (image, s, Some(film))
             },
         ),
     };

@@ -6,6 +6,7 @@ use crate::camera::RayCamera;
 use crate::film::accumulators::Accumulators;
 use crate::film::data::{self, DataContext};
 use crate::film::{Adaptive, PassSet, PixelAcc};
+use crate::integrator::light_split::LightSplit;
 use crate::integrator::{self, Integrator};
 use crate::render_scene::{Ctx, RayQuery, RenderScene};
 use crate::sampler::SobolSampler;
@@ -265,11 +266,19 @@ pub fn validate(opts: &RenderOptions) -> Result<(), RenderError> {
             "samples per pixel must be at least 1".into(),
         ));
     }
-    if integrator::by_name(&opts.integrator, 1).is_none() {
+    let Some(chosen) = integrator::by_name(&opts.integrator, 1) else {
         return Err(RenderError::Invalid(format!(
             "unknown integrator `{}` (choose one of {})",
             opts.integrator,
             integrator::NAMES.join(", ")
+        )));
+    };
+    if opts.passes.has_light() && !chosen.splits_light() {
+        return Err(RenderError::Invalid(format!(
+            "the light passes (diffuse/glossy/transmission direct and indirect) need a \
+             shading integrator (path_mis, path_mats, direct_mis, direct_ems, direct_mats), \
+             not `{}`",
+            opts.integrator
         )));
     }
     if let Some(t) = opts.time_limit
@@ -323,6 +332,7 @@ fn render_samples(
     let transparent = scene.scene.settings.film_transparent;
     let lens = camera.has_lens();
     let adaptive = opts.adaptive.is_some();
+    let light = data.is_some_and(|d| d.passes.has_light());
     for s in acc.next..end {
         ctx.sampler = match sampling {
             Sampling::Sobol => SobolSampler::new(opts.seed, pixel_index, s as u64),
@@ -346,7 +356,12 @@ fn render_samples(
             continue;
         };
         ctx.camera_end = ray.tmax.is_finite().then(|| ray.o + ray.d * ray.tmax);
-        let l = integrator.li(scene, ctx, ray.o, ray.d);
+        let mut split = LightSplit::default();
+        let l = if light {
+            integrator.li_split(scene, ctx, ray.o, ray.d, &mut split)
+        } else {
+            integrator.li(scene, ctx, ray.o, ray.d)
+        };
         if l.is_finite() && l.min_element() >= 0.0 {
             acc.sum += l;
             acc.accepted += 1;
@@ -358,6 +373,9 @@ fn render_samples(
             }
             if let Some(data) = data {
                 data.add_sample(ctx, ray.o, ray.d, acc.accepted == 1, aov);
+                if light {
+                    data.add_light(&split, aov);
+                }
             }
         } else {
             *rejected += 1;
@@ -387,13 +405,11 @@ struct Prepared {
 /// Checks `opts` and sets up the integrator, the camera and the pixel window.
 fn prepare(scene: &RenderScene, opts: &RenderOptions) -> Result<Prepared, RenderError> {
     validate(opts)?;
+    let integrator =
+        integrator::by_name_with(&opts.integrator, opts.max_depth.max(1), opts.light_paths)
+            .ok_or_else(|| RenderError::Invalid("unknown integrator".into()))?;
     Ok(Prepared {
-        integrator: integrator::by_name_with(
-            &opts.integrator,
-            opts.max_depth.max(1),
-            opts.light_paths,
-        )
-        .ok_or_else(|| RenderError::Invalid("unknown integrator".into()))?,
+        integrator,
         camera: RayCamera::new(&scene.scene, opts.width, opts.height),
         region: opts.region.unwrap_or([0, 0, opts.width, opts.height]),
     })
@@ -449,13 +465,20 @@ struct TileState {
 
 impl TileState {
     /// The tile as it stands now.
-    fn snapshot(&self, passes: &PassSet, transparent: bool, spp: u32) -> Tile {
-        let stride = passes.stride();
-        let mut aovs = vec![0.0; self.aov.len()];
+    /// The tile as it stands now, with the passes of `passes` from the sums laid out by
+    /// `acc` (`passes` and what they are computed from).
+    fn snapshot(&self, passes: &PassSet, acc: &PassSet, transparent: bool, spp: u32) -> Tile {
+        let (stride, acc_stride) = (passes.stride(), acc.stride());
+        let mut aovs = vec![0.0; self.px.len() * stride];
+        let noisy = passes.offset(crate::film::Pass::NoisyImage);
         if stride > 0 {
             for (i, p) in self.px.iter().enumerate() {
-                let r = i * stride..(i + 1) * stride;
-                data::resolve(passes, &self.aov[r.clone()], p.accepted, &mut aovs[r]);
+                let out = &mut aovs[i * stride..(i + 1) * stride];
+                let sums = &self.aov[i * acc_stride..(i + 1) * acc_stride];
+                data::resolve(acc, sums, p.accepted, passes, out);
+                if let Some(at) = noisy {
+                    out[at..at + 4].copy_from_slice(&p.rgba(transparent));
+                }
             }
         }
         Tile {
@@ -491,7 +514,10 @@ pub fn render_sampled(
     on_tile: &(dyn Fn(&Tile, usize, usize) + Sync),
 ) -> Result<(Image, RenderStats), RenderError> {
     let (film, stats) = render_film(scene, opts, sampling, 0..opts.spp, cancel, on_tile)?;
-    Ok((film.resolve(), stats))
+    let mut image = film.resolve();
+    // The film also summed the Color passes its light passes are divided by.
+    image.retain_passes(&opts.passes);
+    Ok((image, stats))
 }
 
 /// Renders samples `samples` (`[start, end)`, within `[0, opts.spp)`) of every pixel with the
@@ -548,7 +574,9 @@ fn render_film(
         region: [rx, ry, rw, rh],
     } = prepare(scene, opts)?;
     let ts = opts.tile_size.max(1);
-    let stride = opts.passes.stride();
+    // The film's sums: the passes asked for and the Color passes their light passes need.
+    let acc_passes = opts.passes.with_dividers();
+    let acc_stride = acc_passes.stride();
     let mut tiles = Vec::new();
     for ty in (0..rh).step_by(ts as usize) {
         for tx in (0..rw).step_by(ts as usize) {
@@ -566,16 +594,16 @@ fn render_film(
                     };
                     n
                 ],
-                aov: vec![0.0; n * stride],
+                aov: vec![0.0; n * acc_stride],
                 rays: 0,
                 rejected: 0,
             });
         }
     }
-    let data_ctx = (!opts.passes.is_empty()).then_some(DataContext {
+    let data_ctx = (!acc_passes.is_empty()).then_some(DataContext {
         scene,
         camera: &camera,
-        passes: &opts.passes,
+        passes: &acc_passes,
         mist: scene.scene.settings.mist,
     });
     let transparent = scene.scene.settings.film_transparent;
@@ -628,7 +656,7 @@ fn render_film(
                             &mut ctx,
                             &mut rej,
                             acc,
-                            &mut t.aov[i * stride..(i + 1) * stride],
+                            &mut t.aov[i * acc_stride..(i + 1) * acc_stride],
                             sampling,
                         );
                     }
@@ -637,7 +665,11 @@ fn render_film(
                 t.rejected += rej;
                 let n = done.fetch_add(1, Ordering::Relaxed) + 1;
                 if stream && (worked || last) {
-                    on_tile(&t.snapshot(&opts.passes, transparent, end), n, total);
+                    on_tile(
+                        &t.snapshot(&opts.passes, &acc_passes, transparent, end),
+                        n,
+                        total,
+                    );
                 }
                 Ok(())
             })
@@ -666,7 +698,7 @@ fn render_film(
         for (i, t) in tiles.iter().enumerate() {
             let spp = t.px.iter().map(|p| p.next).max().unwrap_or(0);
             on_tile(
-                &t.snapshot(&opts.passes, transparent, spp),
+                &t.snapshot(&opts.passes, &acc_passes, transparent, spp),
                 total - n + i + 1,
                 total,
             );
@@ -678,11 +710,11 @@ fn render_film(
         height: rh,
         samples: range.clone(),
         spp: opts.spp,
-        passes: opts.passes.clone(),
+        passes: acc_passes.clone(),
         transparent,
         key: String::new(),
         pixels: vec![PixelAcc::default(); rw as usize * rh as usize],
-        aovs: vec![0.0; rw as usize * rh as usize * stride],
+        aovs: vec![0.0; rw as usize * rh as usize * acc_stride],
     };
     let first = range.start;
     let (mut rays, mut rejected, mut samples) = (0u64, 0u64, 0u64);
@@ -692,8 +724,8 @@ fn render_film(
             let src = (y * t.w) as usize..((y + 1) * t.w) as usize;
             let row = (t.y + y) as usize * rw as usize + t.x as usize;
             film.pixels[row..row + t.w as usize].copy_from_slice(&t.px[src.clone()]);
-            film.aovs[row * stride..(row + t.w as usize) * stride]
-                .copy_from_slice(&t.aov[src.start * stride..src.end * stride]);
+            film.aovs[row * acc_stride..(row + t.w as usize) * acc_stride]
+                .copy_from_slice(&t.aov[src.start * acc_stride..src.end * acc_stride]);
         }
         for p in &t.px {
             let n = p.next - first;

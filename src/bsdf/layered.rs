@@ -279,6 +279,13 @@ impl<T: Layer, B: Bsdf> Bsdf for Layered<T, B> {
         self.top.eval(rec) + att * self.base.eval(rec)
     }
 
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        let att = self.top.attenuation(rec.wi);
+        let [td, tg] = self.top.eval_split(rec);
+        let [bd, bg] = self.base.eval_split(rec);
+        [td + att * bd, tg + att * bg]
+    }
+
     fn pdf(&self, rec: &BsdfQueryRecord) -> f32 {
         let (p, _) = self.split(rec.wi);
         let mut pdf = 0.0;
@@ -363,6 +370,9 @@ impl Bsdf for TopLobe {
     fn is_delta(&self) -> bool {
         dispatch_top!(self, b => b.is_delta())
     }
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        dispatch_top!(self, b => b.eval_split(rec))
+    }
 }
 
 impl Layer for TopLobe {
@@ -386,6 +396,9 @@ impl Bsdf for BaseLobe {
     }
     fn is_delta(&self) -> bool {
         dispatch_base!(self, b => b.is_delta())
+    }
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        dispatch_base!(self, b => b.eval_split(rec))
     }
 }
 

@@ -91,6 +91,13 @@ pub trait Bsdf {
     fn pdf(&self, rec: &BsdfQueryRecord) -> f32;
     /// True when every lobe is a Dirac delta (emitter sampling cannot contribute).
     fn is_delta(&self) -> bool;
+    /// The parts of `eval` that Cycles' light passes call diffuse and glossy, as
+    /// `[diffuse, glossy]` in the units of `eval`; what remains of `eval` is transmission
+    /// (Cycles' closure classes: translucent and sheen are diffuse, a glass lobe is glossy on
+    /// the side of `wi` and transmission across). By default the whole value is glossy.
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        [Vec3::ZERO, self.eval(rec)]
+    }
 }
 
 /// The BSDF chosen at one surface hit: a closed set of variants, built on the stack.
@@ -146,6 +153,10 @@ impl Bsdf for BsdfInstance {
     #[inline]
     fn is_delta(&self) -> bool {
         dispatch!(self, b => b.is_delta())
+    }
+    #[inline]
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        dispatch!(self, b => b.eval_split(rec))
     }
 }
 

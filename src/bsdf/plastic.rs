@@ -39,7 +39,7 @@ impl Plastic {
     }
 
     #[inline]
-    fn coat_share(&self, cos_i: f32) -> f32 {
+    pub(crate) fn coat_share(&self, cos_i: f32) -> f32 {
         self.specular * fresnel::schlick1(self.f0, cos_i)
     }
 
@@ -124,5 +124,15 @@ impl Bsdf for Plastic {
 
     fn is_delta(&self) -> bool {
         false
+    }
+
+    /// The Lambertian base is diffuse, the coat glossy.
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        let f = self.eval(rec);
+        if f == Vec3::ZERO {
+            return [Vec3::ZERO; 2];
+        }
+        let diffuse = (1.0 - self.coat_share(rec.wi.z)) * self.base * FRAC_1_PI;
+        [diffuse, (f - diffuse).max(Vec3::ZERO)]
     }
 }

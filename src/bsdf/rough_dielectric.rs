@@ -399,6 +399,15 @@ impl Bsdf for RoughDielectric {
             .0
     }
 
+    /// Reflection is glossy, refraction transmission.
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        if rec.wi.z * rec.wo.z > 0.0 {
+            [Vec3::ZERO, self.eval(rec)]
+        } else {
+            [Vec3::ZERO; 2]
+        }
+    }
+
     fn pdf(&self, rec: &BsdfQueryRecord) -> f32 {
         if rec.wi.z == 0.0 {
             return 0.0;

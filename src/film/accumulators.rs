@@ -49,15 +49,15 @@ impl Accumulators {
     pub fn resolve(&self) -> Image {
         let stride = self.passes.stride();
         let mut aovs = vec![0.0; self.aovs.len()];
+        let noisy = self.passes.offset(Pass::NoisyImage);
         if stride > 0 {
             for (i, p) in self.pixels.iter().enumerate() {
                 let r = i * stride..(i + 1) * stride;
-                data::resolve(
-                    &self.passes,
-                    &self.aovs[r.clone()],
-                    p.accepted,
-                    &mut aovs[r],
-                );
+                let out = &mut aovs[r.clone()];
+                data::resolve(&self.passes, &self.aovs[r], p.accepted, &self.passes, out);
+                if let Some(at) = noisy {
+                    out[at..at + 4].copy_from_slice(&p.rgba(self.transparent));
+                }
             }
         }
         Image {

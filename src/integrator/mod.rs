@@ -10,6 +10,7 @@ pub mod direct_ems;
 pub mod direct_mats;
 pub mod direct_mis;
 pub mod light_paths;
+pub mod light_split;
 pub mod path;
 pub mod scaled;
 
@@ -22,6 +23,26 @@ use glam::Vec3;
 /// One integrator: radiance along the unit-direction ray `o + t d`.
 pub trait Integrator: Send + Sync {
     fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3;
+
+    /// True for integrators that can split their radiance into Cycles' light passes.
+    fn splits_light(&self) -> bool {
+        false
+    }
+
+    /// [`Integrator::li`] (the same value, the same random numbers) with its parts added to
+    /// `split`; integrators that do not split put everything in `split.camera`.
+    fn li_split(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        split: &mut light_split::LightSplit,
+    ) -> Vec3 {
+        let l = self.li(scene, ctx, o, d);
+        split.camera += l;
+        l
+    }
 }
 
 /// The integrators selectable by name. `direct_ems_first_hit` is emitter sampling at the
@@ -225,6 +246,21 @@ impl ShadingPoint {
             BsdfInstance::Sheen(_) => ray::DIFFUSE,
             BsdfInstance::Layered(_) => ray::DIFFUSE | ray::GLOSSY | ray::TRANSMISSION,
         }
+    }
+
+    /// Light-pass weights of light arriving from world direction `wo` (emitter sampling).
+    #[inline]
+    pub fn class_weights_to(&self, wo: Vec3) -> light_split::ClassWeights {
+        light_split::ClassWeights::of(
+            &self.bsdf,
+            &BsdfQueryRecord::pair(self.wi, self.frame.to_local(wo)),
+        )
+    }
+
+    /// Light-pass weights of the direction `sample` returned with `rec`.
+    #[inline]
+    pub fn class_weights_sampled(&self, rec: &BsdfQueryRecord) -> light_split::ClassWeights {
+        light_split::ClassWeights::of(&self.bsdf, rec)
     }
 
     /// True when the chosen BSDF is purely specular.
@@ -515,15 +551,29 @@ pub fn sample_emitter(
     d: Vec3,
     mis: bool,
 ) -> Vec3 {
+    sample_emitter_towards(scene, ctx, its, sp, d, mis).0
+}
+
+/// [`sample_emitter`] and the world direction towards the light sample (zero when none).
+#[inline]
+pub fn sample_emitter_towards(
+    scene: &RenderScene,
+    ctx: &mut Ctx,
+    its: &Intersection,
+    sp: &ShadingPoint,
+    d: Vec3,
+    mis: bool,
+) -> (Vec3, Vec3) {
+    let none = (Vec3::ZERO, Vec3::ZERO);
     let uc = ctx.sampler.next_1d();
     let u = ctx.sampler.next_2d();
     let (light, rec, weight) = scene.sample_light(its.p, uc, u);
     if weight == Vec3::ZERO || !scene.light_reaches(light, sp.light_class()) {
-        return Vec3::ZERO;
+        return none;
     }
     let f = sp.eval_cos(its, d, rec.wi);
     if f == Vec3::ZERO {
-        return Vec3::ZERO;
+        return none;
     }
     let tr = if scene.casts_shadow(light) {
         scene.transmittance(ctx, its.p, its.ng, &rec)
@@ -531,14 +581,14 @@ pub fn sample_emitter(
         Vec3::ONE
     };
     if tr == Vec3::ZERO {
-        return Vec3::ZERO;
+        return none;
     }
     let w = if mis && scene.light_uses_mis(light) {
         mis_weight(rec.pdf, sp.pdf(rec.wi))
     } else {
         1.0
     };
-    f * weight * w * tr
+    (f * weight * w * tr, rec.wi)
 }
 
 /// Traces the ray leaving path vertex `depth - 1` and returns the surface it hits (if any) with
