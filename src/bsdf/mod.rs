@@ -181,7 +181,7 @@ impl BsdfInstance {
         match self {
             BsdfInstance::Plastic(p) => Some(p.eval_parts(rec)),
             BsdfInstance::Layered(l) if matches!(l.base, BaseLobe::Diffuse(_)) => {
-                let att = layered::Layer::attenuation(&l.top, rec.wi);
+                let att = l.attenuation_at(rec.wi);
                 Some((att * l.base.eval(rec), l.top.eval(rec)))
             }
             _ => None,

@@ -159,13 +159,14 @@ impl ShadingPoint {
         {
             // Specular lobes (Glossy, Glass, Refraction, metallic or transmissive Principled)
             // under a normal or bump map reflect above the geometric surface, as Cycles makes
-            // them; the raised normal is found on the viewer's side and keeps its orientation.
+            // them; a transmissive lobe's normal is raised on the viewer's side.
             let ng = if its.ng.dot(-d) < 0.0 {
                 -its.ng
             } else {
                 its.ng
             };
-            let flip = n.dot(-d) < 0.0;
+            // (A transmissive lobe's normal points outwards; a reflective one's is Cycles' N.)
+            let flip = bsdf.is_transmissive() && n.dot(-d) < 0.0;
             let m = bsdf::closure::valid_specular_normal(ng, -d, if flip { -n } else { n });
             n = if flip { -m } else { m };
         }
@@ -213,6 +214,12 @@ impl ShadingPoint {
             };
             if ns.dot(-d) < 0.0 { -ns } else { ns }
         });
+        let wi = frame.to_local(-d);
+        let mut bsdf = bsdf;
+        if let BsdfInstance::Layered(l) = &mut bsdf {
+            // The layering for the direction its top lobe is queried with.
+            l.prepare(glossy_frame.as_ref().map_or(wi, |g| g.to_local(-d)));
+        }
         Some(ShadingPoint {
             smooth,
             glossy_frame,
@@ -221,7 +228,7 @@ impl ShadingPoint {
                 crate::shading::ClosureKind::Transparent { .. }
             ),
             bsdf,
-            wi: frame.to_local(-d),
+            wi,
             frame,
             weight: closure.weight * inv_p,
         })
@@ -311,7 +318,7 @@ impl ShadingPoint {
         };
         let ns = self.smooth.unwrap_or(self.frame.n);
         let (wi_g, wo_g, lo) = (g.to_local(-d), g.to_local(wo), self.frame.to_local(wo));
-        let att = bsdf::layered::Layer::attenuation(&l.top, wi_g);
+        let att = l.attenuation_at(wi_g);
         let base = att
             * l.base.eval(&BsdfQueryRecord::pair(self.wi, lo))
             * lo.z.abs()
