@@ -194,6 +194,13 @@ impl Bsdf for Coat {
         self.lobe.pdf(rec)
     }
 
+    fn eval_and_pdf(&self, rec: &BsdfQueryRecord) -> (Vec3, f32) {
+        if rec.wi.z <= 0.0 || self.smooth() {
+            return (Vec3::ZERO, 0.0);
+        }
+        self.lobe.eval_and_pdf(rec)
+    }
+
     fn is_delta(&self) -> bool {
         self.smooth()
     }
@@ -344,6 +351,20 @@ impl<T: Layer, B: Bsdf> Bsdf for Layered<T, B> {
         pdf
     }
 
+    fn eval_and_pdf(&self, rec: &BsdfQueryRecord) -> (Vec3, f32) {
+        let (p, att) = self.split(rec.wi);
+        let (ft, pt) = self.top.eval_and_pdf(rec);
+        let (fb, pb) = self.base.eval_and_pdf(rec);
+        let mut pdf = 0.0;
+        if p > 0.0 {
+            pdf += p * pt;
+        }
+        if p < 1.0 {
+            pdf += (1.0 - p) * pb;
+        }
+        (ft + att * fb, pdf)
+    }
+
     fn is_delta(&self) -> bool {
         self.top.is_delta() && self.base.is_delta()
     }
@@ -419,6 +440,9 @@ impl Bsdf for TopLobe {
     fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
         dispatch_top!(self, b => b.eval_split(rec))
     }
+    fn eval_and_pdf(&self, rec: &BsdfQueryRecord) -> (Vec3, f32) {
+        dispatch_top!(self, b => b.eval_and_pdf(rec))
+    }
 }
 
 impl Layer for TopLobe {
@@ -451,6 +475,9 @@ impl Bsdf for BaseLobe {
     }
     fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
         dispatch_base!(self, b => b.eval_split(rec))
+    }
+    fn eval_and_pdf(&self, rec: &BsdfQueryRecord) -> (Vec3, f32) {
+        dispatch_base!(self, b => b.eval_and_pdf(rec))
     }
 }
 

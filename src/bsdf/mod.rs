@@ -98,6 +98,10 @@ pub trait Bsdf {
     fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
         [Vec3::ZERO, self.eval(rec)]
     }
+    /// `(eval(rec), pdf(rec))` at once (the same values; a lobe may share their work).
+    fn eval_and_pdf(&self, rec: &BsdfQueryRecord) -> (Vec3, f32) {
+        (self.eval(rec), self.pdf(rec))
+    }
 }
 
 /// The BSDF chosen at one surface hit: a closed set of variants, built on the stack.
@@ -105,6 +109,9 @@ pub trait Bsdf {
 /// Lobes that live in a tangent frame (anisotropic [`RoughConductor`], [`RoughDielectric`]
 /// with `alpha_x != alpha_y`) take local +X as the tangent: the caller builds the shading frame
 /// from the (rotated) tangent for them.
+// Built on the stack once per hit and never stored in bulk: boxing the large layered variant
+// would put an allocation in the hot loop.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug)]
 pub enum BsdfInstance {
     Diffuse(Diffuse),
@@ -157,6 +164,10 @@ impl Bsdf for BsdfInstance {
     #[inline]
     fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
         dispatch!(self, b => b.eval_split(rec))
+    }
+    #[inline]
+    fn eval_and_pdf(&self, rec: &BsdfQueryRecord) -> (Vec3, f32) {
+        dispatch!(self, b => b.eval_and_pdf(rec))
     }
 }
 

@@ -438,6 +438,14 @@ impl Bsdf for RoughDielectric {
             .1
     }
 
+    fn eval_and_pdf(&self, rec: &BsdfQueryRecord) -> (Vec3, f32) {
+        if rec.wi.z == 0.0 {
+            return (Vec3::ZERO, 0.0);
+        }
+        let (flip, eta) = self.side(rec.wi);
+        self.eval_pdf(mirror(rec.wi, flip), mirror(rec.wo, flip), eta)
+    }
+
     fn is_delta(&self) -> bool {
         false
     }

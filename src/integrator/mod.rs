@@ -294,6 +294,44 @@ impl ShadingPoint {
         }
     }
 
+    /// `(eval_cos(wo), pdf(wo))` with the work they share done once (the same values; the
+    /// pdf is left zero where the value is).
+    #[inline]
+    pub fn eval_cos_pdf(&self, its: &Intersection, d: Vec3, wo: Vec3) -> (Vec3, f32) {
+        if !self.bsdf.is_transmissive() && its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
+            return (Vec3::ZERO, 0.0);
+        }
+        match (&self.glossy_frame, self.smooth) {
+            (Some(g), _) => {
+                let (f, pdf) = self.two_frame_eval_cos_pdf(g, d, wo);
+                (f * self.weight, pdf)
+            }
+            (None, None) => {
+                let lo = self.frame.to_local(wo);
+                let (f, pdf) = self.bsdf.eval_and_pdf(&BsdfQueryRecord::pair(self.wi, lo));
+                (f * lo.z.abs() * self.weight, pdf)
+            }
+            (None, Some(_)) => (self.eval_cos(its, d, wo), self.pdf(wo)),
+        }
+    }
+
+    /// [`Self::two_frame_eval_cos`] (for evaluation) and [`Self::two_frame_pdf`] together.
+    #[inline]
+    fn two_frame_eval_cos_pdf(&self, g: &Frame, d: Vec3, wo: Vec3) -> (Vec3, f32) {
+        let BsdfInstance::Layered(l) = &self.bsdf else {
+            return (Vec3::ZERO, 0.0);
+        };
+        let ns = self.smooth.unwrap_or(self.frame.n);
+        let (wi_g, wo_g, lo) = (g.to_local(-d), g.to_local(wo), self.frame.to_local(wo));
+        let att = l.attenuation_at(wi_g);
+        let (fb, pb) = l.base.eval_and_pdf(&BsdfQueryRecord::pair(self.wi, lo));
+        let (ft, pt) = l.top.eval_and_pdf(&BsdfQueryRecord::pair(wi_g, wo_g));
+        let base = att * fb * lo.z.abs() * Self::bump_term(self.frame.n, ns, wo, true, true);
+        let top = ft * wo_g.z.abs() * Self::bump_term(g.n, ns, wo, true, false);
+        let p = l.top_probability(wi_g);
+        (base + top, p * pt + (1.0 - p) * pb)
+    }
+
     /// The BSDF at `rec` (per steradian) with the bump corrections for a closure normal off
     /// the interpolated one `ns`; a diffuse base under a glossy coat is corrected as the
     /// diffuse closure it is in Cycles, the coat as a glossy one.
@@ -578,7 +616,12 @@ pub fn sample_emitter_towards(
     if weight == Vec3::ZERO || !scene.light_reaches(light, sp.light_class()) {
         return none;
     }
-    let f = sp.eval_cos(its, d, rec.wi);
+    let mis = mis && scene.light_uses_mis(light);
+    let (f, bsdf_pdf) = if mis {
+        sp.eval_cos_pdf(its, d, rec.wi)
+    } else {
+        (sp.eval_cos(its, d, rec.wi), 0.0)
+    };
     if f == Vec3::ZERO {
         return none;
     }
@@ -590,8 +633,8 @@ pub fn sample_emitter_towards(
     if tr == Vec3::ZERO {
         return none;
     }
-    let w = if mis && scene.light_uses_mis(light) {
-        mis_weight(rec.pdf, sp.pdf(rec.wi))
+    let w = if mis {
+        mis_weight(rec.pdf, bsdf_pdf)
     } else {
         1.0
     };

@@ -61,7 +61,7 @@ pub enum Projection {
 fn box_weights(n: Vec3, blend: f32) -> Vec3 {
     let a = n.abs();
     let sum = a.x + a.y + a.z;
-    if !(sum > 0.0) {
+    if sum.is_nan() || sum <= 0.0 {
         return Vec3::X;
     }
     let n = a / sum;
@@ -97,7 +97,7 @@ fn box_weights(n: Vec3, blend: f32) -> Vec3 {
 /// Cycles' `map_to_sphere` of a point (u from the angle about Z, v from the polar angle).
 fn map_to_sphere(co: Vec3) -> Vec2 {
     let l = co.length_squared();
-    if !(l > 0.0) {
+    if l.is_nan() || l <= 0.0 {
         return Vec2::ZERO;
     }
     let u = if co.x == 0.0 && co.y == 0.0 {
@@ -111,7 +111,8 @@ fn map_to_sphere(co: Vec3) -> Vec2 {
 
 /// Cycles' `map_to_tube`.
 fn map_to_tube(co: Vec3) -> Vec2 {
-    if !(co.x * co.x + co.y * co.y > 0.0) {
+    let r2 = co.x * co.x + co.y * co.y;
+    if r2.is_nan() || r2 <= 0.0 {
         return Vec2::ZERO;
     }
     let u = (1.0 - co.x.atan2(co.y) * std::f32::consts::FRAC_1_PI) * 0.5;
