@@ -40,8 +40,8 @@ mod tests {
 
     #[test]
     fn dividers_follow_cycles() {
-        // 1920x1080 > 64²: halved until 30x16 (480 pixels <= 4096) -> 64.
-        assert_eq!(start_divider(1920, 1080, 64, 1), 64);
+        // 1920x1080 halved five times is 60x33 (1980 pixels <= 64²): divider 32.
+        assert_eq!(start_divider(1920, 1080, 64, 1), 32);
         assert_eq!(start_divider(64, 64, 64, 1), 1);
         assert_eq!(start_divider(65, 64, 64, 1), 2);
         assert_eq!(start_divider(100, 100, 0, 2), 2);
