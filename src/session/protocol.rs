@@ -26,6 +26,7 @@ pub const STATS: u32 = 17;
 pub const MAX_PAYLOAD: u32 = 1 << 30;
 
 /// LOG levels.
+pub const LOG_DEBUG: u32 = 0;
 pub const LOG_INFO: u32 = 1;
 pub const LOG_WARNING: u32 = 2;
 

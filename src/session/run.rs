@@ -314,7 +314,10 @@ pub fn run(
                 }
             }
             Ok(None) => {}
-            Err(RenderError::Cancelled) => {}
+            Err(RenderError::Cancelled) => {
+                let msg = format!("generation {}: pass cancelled by a command", j.generation);
+                out.frame(protocol::LOG, &protocol::log(protocol::LOG_DEBUG, &msg));
+            }
             Err(RenderError::Invalid(m)) => {
                 out.error(Some("render"), &Value::Null, &m, false);
                 j.done = true;

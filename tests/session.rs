@@ -1,0 +1,674 @@
+//! `tesela session` driven as the add-on drives it: a scripted client on the real binary's
+//! pipes (docs/session.md). Every command, cancellation of a pass in flight, a flood of
+//! views, malformed commands, end of input, and the pixels against `tesela render`.
+//!
+//! Each wait has a deadline that only a hang reaches (a test never asserts a speed).
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, channel};
+use std::time::{Duration, Instant};
+
+use serde_json::{Value, json};
+
+const COMMAND: u32 = 32;
+const HELLO: u32 = 1;
+const LOG: u32 = 4;
+const ERROR: u32 = 5;
+const IMAGE: u32 = 16;
+
+/// Long enough that only a hang reaches it.
+const DEADLINE: Duration = Duration::from_secs(60);
+
+/// An IMAGE frame.
+#[derive(Clone, Debug)]
+struct Image {
+    generation: u64,
+    pixel_size: u32,
+    width: u32,
+    height: u32,
+    samples: u32,
+    last: bool,
+    pixels: Vec<f32>,
+}
+
+impl Image {
+    fn parse(p: &[u8]) -> Image {
+        let u = |i: usize| u32::from_le_bytes(p[8 + 4 * i..12 + 4 * i].try_into().unwrap());
+        let (w, h) = (u(7), u(8));
+        let pixels: Vec<f32> = (p[52..].chunks_exact(4))
+            .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        assert_eq!(pixels.len(), (w * h * 4) as usize, "IMAGE size");
+        Image {
+            generation: u64::from_le_bytes(p[..8].try_into().unwrap()),
+            pixel_size: u(6),
+            width: w,
+            height: h,
+            samples: u(9),
+            last: u(10) & 1 != 0,
+            pixels,
+        }
+    }
+
+    /// Mean of channel `c` over the image.
+    fn mean(&self, c: usize) -> f64 {
+        let v: Vec<f64> = self
+            .pixels
+            .iter()
+            .skip(c)
+            .step_by(4)
+            .map(|&x| x as f64)
+            .collect();
+        v.iter().sum::<f64>() / v.len() as f64
+    }
+}
+
+fn read_frame(r: &mut impl Read) -> Option<(u32, Vec<u8>)> {
+    let mut h = [0u8; 8];
+    r.read_exact(&mut h).ok()?;
+    let kind = u32::from_le_bytes(h[..4].try_into().unwrap());
+    let len = u32::from_le_bytes(h[4..].try_into().unwrap()) as usize;
+    let mut p = vec![0u8; len];
+    r.read_exact(&mut p).ok()?;
+    Some((kind, p))
+}
+
+fn command(v: &Value) -> Vec<u8> {
+    let j = v.to_string().into_bytes();
+    let mut payload = (j.len() as u32).to_le_bytes().to_vec();
+    payload.extend_from_slice(&j);
+    frame(COMMAND, &payload)
+}
+
+fn frame(kind: u32, payload: &[u8]) -> Vec<u8> {
+    let mut f = kind.to_le_bytes().to_vec();
+    f.extend_from_slice(&(payload.len() as u32).to_le_bytes());
+    f.extend_from_slice(payload);
+    f
+}
+
+/// A running session with its frames arriving on a channel.
+struct Session {
+    child: Child,
+    stdin: Option<ChildStdin>,
+    frames: Receiver<(u32, Vec<u8>)>,
+}
+
+impl Session {
+    fn start() -> Session {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_tesela"))
+            .args(["session", "--threads", "2"])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("cannot start tesela session");
+        let mut out = child.stdout.take().unwrap();
+        let (tx, rx) = channel();
+        std::thread::spawn(move || {
+            while let Some(f) = read_frame(&mut out) {
+                if tx.send(f).is_err() {
+                    break;
+                }
+            }
+        });
+        let stdin = child.stdin.take();
+        let s = Session {
+            child,
+            stdin,
+            frames: rx,
+        };
+        let (kind, p) = s.next().expect("no HELLO");
+        assert_eq!(kind, HELLO);
+        assert_eq!(&p[..4], b"TSLS");
+        assert_eq!(u32::from_le_bytes(p[4..8].try_into().unwrap()), 1);
+        s
+    }
+
+    fn send(&mut self, v: Value) {
+        self.send_raw(&command(&v));
+    }
+
+    fn send_raw(&mut self, bytes: &[u8]) {
+        let s = self.stdin.as_mut().unwrap();
+        s.write_all(bytes).unwrap();
+        s.flush().unwrap();
+    }
+
+    fn next(&self) -> Option<(u32, Vec<u8>)> {
+        match self.frames.recv_timeout(DEADLINE) {
+            Ok(f) => Some(f),
+            Err(RecvTimeoutError::Timeout) => panic!("no frame within {DEADLINE:?}: a hang"),
+            Err(RecvTimeoutError::Disconnected) => None,
+        }
+    }
+
+    /// The frames up to the last IMAGE of generation `generation` (which is returned), with
+    /// every IMAGE and ERROR before it.
+    fn finish(&self, generation: u64) -> (Image, Vec<Image>, Vec<Value>) {
+        let (mut images, mut errors) = (Vec::new(), Vec::new());
+        loop {
+            let (kind, p) = self.next().expect("the session ended");
+            match kind {
+                IMAGE => {
+                    let im = Image::parse(&p);
+                    images.push(im.clone());
+                    if im.last && im.generation == generation {
+                        return (im, images, errors);
+                    }
+                }
+                ERROR => errors.push(serde_json::from_slice(&p).unwrap()),
+                _ => {}
+            }
+        }
+    }
+
+    /// The next ERROR frame (skipping the others).
+    fn error(&self) -> Value {
+        loop {
+            let (kind, p) = self.next().expect("the session ended");
+            if kind == ERROR {
+                return serde_json::from_slice(&p).unwrap();
+            }
+        }
+    }
+
+    /// Closes stdin and waits for the exit status.
+    fn close(mut self) -> i32 {
+        drop(self.stdin.take());
+        let t = Instant::now();
+        loop {
+            if let Some(s) = self.child.try_wait().unwrap() {
+                return s.code().unwrap_or(-1);
+            }
+            assert!(t.elapsed() < DEADLINE, "the session did not exit at EOF");
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+}
+
+impl Drop for Session {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// A folder of its own for test `name`.
+fn folder(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tesela-session-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The camera the test scene and the views use.
+fn tesela_camera() -> Value {
+    json!({"type": "PERSP", "lens": 35.0, "sensor_width": 36.0, "sensor_fit": "AUTO",
+           "clip_start": 0.0})
+}
+
+fn camera_matrix(z: f32) -> Vec<f32> {
+    vec![
+        1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.5, z, 1.0,
+    ]
+}
+
+/// The shipped Cornell box with a Blender camera, written into `dir`.
+fn scene(dir: &Path) -> PathBuf {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-box.gltf");
+    let mut doc: Value = serde_json::from_slice(&std::fs::read(src).unwrap()).unwrap();
+    for n in doc["nodes"].as_array_mut().unwrap() {
+        if n.get("camera").is_some() {
+            n["matrix"] = json!(camera_matrix(1.94));
+            n["extensions"] = json!({"TESELA_camera": tesela_camera()});
+        }
+    }
+    doc["extensionsUsed"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!("TESELA_camera"));
+    let path = dir.join("scene.gltf");
+    std::fs::write(&path, doc.to_string()).unwrap();
+    path
+}
+
+/// A file with one mesh named `name`: a large quad across the box's floor.
+fn mesh_file(dir: &Path, name: &str) -> PathBuf {
+    let pos: [[f32; 3]; 4] = [
+        [-0.5, 0.01, -0.5],
+        [0.5, 0.01, -0.5],
+        [0.5, 0.6, 0.5],
+        [-0.5, 0.6, 0.5],
+    ];
+    let idx: [u32; 6] = [0, 2, 1, 0, 3, 2];
+    let mut bin: Vec<u8> = pos.iter().flatten().flat_map(|f| f.to_le_bytes()).collect();
+    bin.extend(idx.iter().flat_map(|i| i.to_le_bytes()));
+    std::fs::write(dir.join("mesh.bin"), &bin).unwrap();
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "buffers": [{"uri": "mesh.bin", "byteLength": bin.len()}],
+        "bufferViews": [{"buffer": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 24}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+             "min": [-0.5, 0.01, -0.5], "max": [0.5, 0.6, 0.5]},
+            {"bufferView": 1, "componentType": 5125, "count": 6, "type": "SCALAR"}],
+        "materials": [{"name": "green", "doubleSided": true}],
+        "meshes": [{"name": name, "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+        "nodes": [{"name": name, "mesh": 0}],
+        "scenes": [{"nodes": [0]}],
+    });
+    let path = dir.join("mesh.gltf");
+    std::fs::write(&path, doc.to_string()).unwrap();
+    path
+}
+
+fn view(width: u32, height: u32, z: f32) -> Value {
+    json!({"cmd": "view", "width": width, "height": height,
+           "camera": {"matrix": camera_matrix(z), "camera": tesela_camera()}})
+}
+
+/// Largest absolute difference between two images of the same size.
+fn max_diff(a: &Image, b: &Image) -> f32 {
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    (a.pixels.iter().zip(&b.pixels))
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f32::max)
+}
+
+/// Starts a session on the test scene with a small view and `samples`; the first image.
+fn started(name: &str, samples: u32) -> (Session, PathBuf, Image) {
+    let dir = folder(name);
+    let path = scene(&dir);
+    let mut s = Session::start();
+    s.send(json!({"cmd": "settings", "samples": samples, "start_resolution": 16}));
+    s.send(json!({"cmd": "load", "path": path}));
+    s.send(view(48, 36, 1.94));
+    let (im, images, errors) = s.finish(3);
+    assert!(errors.is_empty(), "{errors:?}");
+    // Reduced passes first, at pixel sizes halving down to 1.
+    assert!(images[0].pixel_size > 1, "no reduced first pass");
+    let sizes: Vec<u32> = images.iter().map(|i| i.pixel_size).collect();
+    assert!(sizes.windows(2).all(|w| w[1] <= w[0]), "{sizes:?}");
+    (s, dir, im)
+}
+
+#[test]
+fn every_command_changes_what_it_should() {
+    let (mut s, dir, base) = started("commands", 2);
+    assert_eq!((base.width, base.height, base.samples), (48, 36, 2));
+    let mut generation = 3;
+    let mut step = |s: &mut Session, cmd: Value| -> Image {
+        s.send(cmd.clone());
+        generation += 1;
+        let (im, _, errors) = s.finish(generation);
+        assert!(errors.is_empty(), "{cmd}: {errors:?}");
+        im
+    };
+
+    // A camera move: the image changes.
+    let moved = step(&mut s, view(48, 36, 2.6));
+    assert!(
+        max_diff(&moved, &base) > 0.05,
+        "view did not move the camera"
+    );
+    let back = step(&mut s, view(48, 36, 1.94));
+    assert_eq!(
+        max_diff(&back, &base),
+        0.0,
+        "the same view must give the same pixels"
+    );
+
+    // The red wall turns blue: blue rises, red falls.
+    let blue = step(
+        &mut s,
+        json!({"cmd": "material", "name": "red", "material": {"name": "red",
+            "pbrMetallicRoughness": {"baseColorFactor": [0.05, 0.05, 0.8, 1.0],
+            "metallicFactor": 0.0, "roughnessFactor": 1.0}}}),
+    );
+    assert!(blue.mean(2) > base.mean(2) * 1.1 && blue.mean(0) < base.mean(0) * 0.95);
+
+    // A new light brightens the box; moving it changes the image again.
+    let lamp_at = |y: f32| {
+        vec![
+            1.0f32, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, y, 0.0, 1.0,
+        ]
+    };
+    let lit = step(
+        &mut s,
+        json!({"cmd": "light", "node": "lamp", "matrix": lamp_at(0.6),
+               "light": {"type": "POINT", "color": [1, 1, 1], "power": 20.0}}),
+    );
+    assert!(lit.mean(1) > blue.mean(1) * 1.2, "the light did not light");
+    let lit_moved = step(
+        &mut s,
+        json!({"cmd": "transform", "node": "lamp", "matrix": lamp_at(0.2)}),
+    );
+    assert!(max_diff(&lit_moved, &lit) > 0.05, "the light did not move");
+    let dimmer = step(
+        &mut s,
+        json!({"cmd": "light", "node": "lamp", "light": {"type": "POINT", "power": 5.0}}),
+    );
+    assert!(
+        dimmer.mean(1) < lit_moved.mean(1),
+        "the light's power did not change"
+    );
+
+    // Moving a block.
+    let m = vec![
+        1.0f32, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.3, 0.0, 0.0, 1.0,
+    ];
+    let block = step(
+        &mut s,
+        json!({"cmd": "transform", "node": "tall block", "matrix": m}),
+    );
+    assert!(max_diff(&block, &dimmer) > 0.05, "the block did not move");
+
+    // The world: a bright sky seen through the open front brightens the image.
+    let sky = step(
+        &mut s,
+        json!({"cmd": "world", "world": {"color": [1.0, 1.0, 1.0], "strength": 2.0}}),
+    );
+    assert!(
+        sky.mean(1) > block.mean(1) * 1.05,
+        "the world did not change"
+    );
+
+    // Hiding and showing an object: showing restores the very same pixels.
+    let hidden = step(
+        &mut s,
+        json!({"cmd": "visibility", "node": "short block", "visible": false}),
+    );
+    assert!(max_diff(&hidden, &sky) > 0.05, "the block was not hidden");
+    let shown = step(
+        &mut s,
+        json!({"cmd": "visibility", "node": "short block", "visible": true}),
+    );
+    assert_eq!(
+        max_diff(&shown, &sky),
+        0.0,
+        "showing again must restore the image"
+    );
+
+    // Replacing a mesh.
+    let file = mesh_file(&dir, "short block");
+    let replaced = step(
+        &mut s,
+        json!({"cmd": "mesh", "name": "short block", "path": file}),
+    );
+    assert!(
+        max_diff(&replaced, &shown) > 0.05,
+        "the mesh was not replaced"
+    );
+
+    // Settings: more samples refine the same generation's image further.
+    let more = step(&mut s, json!({"cmd": "settings", "samples": 4}));
+    assert_eq!(more.samples, 4);
+
+    // Pause: no image while paused (samples 0 renders forever otherwise); resume goes on.
+    s.send(json!({"cmd": "settings", "samples": 0}));
+    generation += 1;
+    loop {
+        let (kind, p) = s.next().unwrap();
+        if kind == IMAGE && Image::parse(&p).samples >= 8 {
+            break;
+        }
+    }
+    s.send(json!({"cmd": "pause"}));
+    let mut last_before = 0;
+    let paused_at = Instant::now();
+    while paused_at.elapsed() < Duration::from_millis(400) {
+        match s.frames.recv_timeout(Duration::from_millis(50)) {
+            Ok((IMAGE, p)) => {
+                let im = Image::parse(&p);
+                assert!(
+                    paused_at.elapsed() < Duration::from_millis(200),
+                    "IMAGE {} spp while paused",
+                    im.samples
+                );
+                last_before = im.samples;
+            }
+            _ => continue,
+        }
+    }
+    s.send(json!({"cmd": "resume"}));
+    loop {
+        let (kind, p) = s.next().unwrap();
+        if kind == IMAGE {
+            let im = Image::parse(&p);
+            assert_eq!(im.generation, generation);
+            if im.samples > last_before + 16 {
+                break;
+            }
+        }
+    }
+    s.send(json!({"cmd": "stop"}));
+    assert_eq!(s.close(), 0);
+}
+
+#[test]
+fn a_command_cancels_the_pass_in_flight() {
+    let (mut s, _dir, _) = started("cancel", 2);
+    // 256x256 with no sample target: the round from 16 to 32 samples is a million samples.
+    s.send(json!({"cmd": "settings", "samples": 0}));
+    s.send(view(256, 256, 1.94));
+    loop {
+        let (kind, p) = s.next().unwrap();
+        if kind == IMAGE {
+            let im = Image::parse(&p);
+            if im.generation == 5 && im.samples == 16 {
+                break;
+            }
+        }
+    }
+    // The round from 16 to 32 samples starts after the STATS that follows; it renders for
+    // far longer than this pause.
+    while s.next().is_some_and(|(k, _)| k != 17) {}
+    std::thread::sleep(Duration::from_millis(50));
+    {
+        {}
+    }
+    let sent = Instant::now();
+    s.send(view(256, 256, 2.2));
+    let mut cancelled = false;
+    loop {
+        let (kind, p) = s.next().unwrap();
+        if kind == LOG && String::from_utf8_lossy(&p[4..]).contains("generation 5: pass cancelled")
+        {
+            cancelled = true;
+        }
+        if kind == IMAGE {
+            let im = Image::parse(&p);
+            assert_eq!(
+                im.generation, 6,
+                "the pass of 16 to 32 samples was finished, not cancelled"
+            );
+            eprintln!(
+                "first image after the command: {:.1} ms (pixel size {})",
+                sent.elapsed().as_secs_f64() * 1e3,
+                im.pixel_size
+            );
+            break;
+        }
+    }
+    assert!(cancelled, "no pass was cancelled");
+    assert_eq!(s.close(), 0);
+}
+
+#[test]
+fn a_flood_of_views_renders_only_the_newest() {
+    let (mut s, _dir, _) = started("flood", 1);
+    let mut flood = Vec::new();
+    for k in 0..200 {
+        flood.extend(command(&view(48, 36, 1.94 + k as f32 * 0.005)));
+    }
+    s.send_raw(&flood);
+    let (last, images, errors) = s.finish(3 + 200);
+    assert!(errors.is_empty(), "{errors:?}");
+    let mut generations: Vec<u64> = images.iter().map(|i| i.generation).collect();
+    generations.dedup();
+    eprintln!("generations rendered during the flood: {generations:?}");
+    assert!(
+        generations.len() <= 5,
+        "{} of 200 views were rendered: {generations:?}",
+        generations.len()
+    );
+    // The newest is the one rendered to the end: the same as that view alone.
+    let mut alone = Session::start();
+    alone.send(json!({"cmd": "settings", "samples": 1, "start_resolution": 16}));
+    alone.send(json!({"cmd": "load", "path": scene(&folder("flood-alone"))}));
+    alone.send(view(48, 36, 1.94 + 199.0 * 0.005));
+    let (want, _, _) = alone.finish(3);
+    assert_eq!(max_diff(&last, &want), 0.0);
+    assert_eq!(s.close(), 0);
+}
+
+#[test]
+fn malformed_commands_are_answered_and_the_session_survives() {
+    let (mut s, dir, base) = started("malformed", 1);
+    let cases: Vec<(Vec<u8>, Option<&str>, &str)> = vec![
+        (frame(9, b"hello"), None, "not a command"),
+        (frame(COMMAND, b"\x05\x00\x00\x00{oops"), None, "not JSON"),
+        (frame(COMMAND, &[1, 2]), None, "JSON length"),
+        (
+            command(&json!({"cmd": "warp"})),
+            Some("warp"),
+            "unknown command",
+        ),
+        (
+            command(&json!({"cmd": "view", "width": -3, "height": 2, "camera": {}})),
+            Some("view"),
+            "width",
+        ),
+        (
+            command(&json!({"cmd": "transform", "node": "nobody", "matrix": camera_matrix(1.0)})),
+            Some("transform"),
+            "no node named `nobody`",
+        ),
+        (
+            command(&json!({"cmd": "material", "name": "nothing", "material": {}})),
+            Some("material"),
+            "no material named",
+        ),
+        (
+            command(&json!({"cmd": "load", "path": dir.join("missing.gltf")})),
+            Some("load"),
+            "missing.gltf",
+        ),
+        (
+            command(&json!({"cmd": "settings", "pixel_size": 3})),
+            Some("settings"),
+            "pixel_size",
+        ),
+        (
+            command(&json!({"cmd": "visibility", "node": "floor", "visible": "no"})),
+            Some("visibility"),
+            "true or false",
+        ),
+        (
+            command(
+                &json!({"cmd": "light", "node": "floor", "light": {"type": "POINT"}, "matrix": [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1]}),
+            ),
+            Some("light"),
+            "singular",
+        ),
+    ];
+    for (bytes, cmd, want) in cases {
+        s.send_raw(&bytes);
+        let e = s.error();
+        assert_eq!(e["command"].as_str(), cmd, "{e}");
+        assert_eq!(e["fatal"], json!(false));
+        let m = e["message"].as_str().unwrap();
+        assert!(m.contains(want), "`{want}` not in: {m}");
+    }
+    // Nothing changed: the next command works on the last good state.
+    s.send(view(48, 36, 1.94));
+    let (im, _, errors) = s.finish(4);
+    assert!(errors.is_empty(), "{errors:?}");
+    assert_eq!(max_diff(&im, &base), 0.0);
+    assert_eq!(s.close(), 0);
+}
+
+#[test]
+fn end_of_input_exits_with_status_zero_even_mid_render() {
+    let (mut s, _dir, _) = started("eof", 1);
+    s.send(json!({"cmd": "settings", "samples": 0}));
+    s.send(view(128, 128, 1.94));
+    while s.next().is_some_and(|(k, _)| k != IMAGE) {}
+    assert_eq!(s.close(), 0);
+}
+
+/// `tesela render --pipe` of `path`: its Combined RGBA pixels.
+fn render_pixels(path: &Path, width: u32, height: u32, spp: u32) -> Vec<f32> {
+    // The pipe mode stops when its stdin closes: keep it open until DONE.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tesela"))
+        .arg("render")
+        .arg(path)
+        .args(["--pipe", "--threads", "1", "--seed", "0"])
+        .args([
+            "--width",
+            &width.to_string(),
+            "--height",
+            &height.to_string(),
+        ])
+        .args(["--spp", &spp.to_string(), "--max-depth", "16"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let stdin = child.stdin.take();
+    let mut stdout = Vec::new();
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_end(&mut stdout)
+        .unwrap();
+    drop(stdin);
+    assert!(child.wait().unwrap().success(), "tesela render failed");
+    let mut pixels = vec![0f32; (width * height * 4) as usize];
+    let mut r = &stdout[..];
+    while let Some((kind, p)) = read_frame(&mut r) {
+        if kind == 2 {
+            let u = |i: usize| u32::from_le_bytes(p[4 * i..4 * i + 4].try_into().unwrap());
+            let (x, y, w, h) = (u(0), u(1), u(2), u(3));
+            let data: Vec<f32> = (p[16..].chunks_exact(4))
+                .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+                .collect();
+            for ty in 0..h {
+                for tx in 0..w {
+                    let at = (((y + ty) * width + x + tx) * 4) as usize;
+                    let from = ((ty * w + tx) * 4) as usize;
+                    pixels[at..at + 4].copy_from_slice(&data[from..from + 4]);
+                }
+            }
+        }
+    }
+    pixels
+}
+
+#[test]
+fn full_resolution_equals_tesela_render_bit_for_bit() {
+    let (mut s, dir, _) = started("same-pixels", 8);
+    // A 37x29 view: tiles and rows that do not divide evenly.
+    s.send(view(37, 29, 1.94));
+    let (im, images, _) = s.finish(4);
+    // The session reached 8 samples in rounds of 1, 2, 4, 8 (on 2 threads).
+    let rounds: Vec<u32> = (images.iter())
+        .filter(|i| i.generation == 4 && i.pixel_size == 1)
+        .map(|i| i.samples)
+        .collect();
+    assert_eq!(rounds, [1, 2, 4, 8]);
+    let want = render_pixels(&dir.join("scene.gltf"), 37, 29, 8);
+    let same = (im.pixels.iter().zip(&want)).all(|(a, b)| a.to_bits() == b.to_bits());
+    let worst = (im.pixels.iter().zip(&want))
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f32::max);
+    assert!(
+        same,
+        "pixels differ from tesela render (largest difference {worst})"
+    );
+    assert_eq!(s.close(), 0);
+}
