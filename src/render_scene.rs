@@ -460,6 +460,29 @@ impl RenderScene {
         warnings
     }
 
+    /// Whether some instance's material may emit (such instances are baked into world space,
+    /// so moving one means building the world's BVH again).
+    pub fn instances_emit(&self) -> bool {
+        self.scene.instances.iter().any(|i| {
+            let m = (self.scene.meshes.get(i.mesh))
+                .map_or(0, |mesh| i.material.unwrap_or(mesh.material));
+            self.programs.get(m).is_none_or(|p| p.may_emit())
+        })
+    }
+
+    /// After `scene.instances` changed (moved, added, removed) and the meshes `changed` got new
+    /// triangles: builds the top level again (and the bottom levels of `changed`), the
+    /// scene's radius and the emitters; the world-space BVH stays. Needs
+    /// `!instances_emit()` before and after.
+    pub fn refresh_instances(&mut self, changed: &[usize]) -> Vec<String> {
+        self.instances = InstanceAccel::rebuilt(&self.scene, self.instances.take(), changed);
+        self.radius = match self.scene.bounds() {
+            Some((lo, hi)) => ((hi - lo) * 0.5).length().max(1e-3),
+            None => 1.0,
+        };
+        self.refresh_shading()
+    }
+
     /// Rebuilds the emitters only (lights or the world changed; the materials did not).
     pub fn refresh_lights(&mut self) -> Vec<String> {
         let mut warnings = Vec::new();

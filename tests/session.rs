@@ -672,3 +672,38 @@ fn full_resolution_equals_tesela_render_bit_for_bit() {
     );
     assert_eq!(s.close(), 0);
 }
+
+#[test]
+fn moving_an_object_twice_lands_where_one_move_does() {
+    // The first move turns the baked block into an instance (the world's BVH is built once
+    // more); the second only places the instance again.
+    let at = |x: f32| {
+        json!([
+            1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, x, 0.0, 0.0, 1.0
+        ])
+    };
+    let (mut twice, _d1, still) = started("move-twice", 2);
+    twice.send(json!({"cmd": "transform", "node": "tall block", "matrix": at(0.2)}));
+    twice.send(json!({"cmd": "transform", "node": "tall block", "matrix": at(-0.25)}));
+    let (a, _, errors) = twice.finish(5);
+    assert!(errors.is_empty(), "{errors:?}");
+    let (mut once, _d2, _) = started("move-once", 2);
+    once.send(json!({"cmd": "transform", "node": "tall block", "matrix": at(-0.25)}));
+    let (b, _, _) = once.finish(4);
+    let mean_diff = |x: &Image, y: &Image| {
+        (x.pixels.iter().zip(&y.pixels))
+            .map(|(p, q)| (p - q).abs() as f64)
+            .sum::<f64>()
+            / x.pixels.len() as f64
+    };
+    let moved = mean_diff(&a, &still);
+    let apart = mean_diff(&a, &b);
+    eprintln!("mean |twice - once| {apart:.2e}, |twice - unmoved| {moved:.2e}");
+    assert!(moved > 1e-2, "the block did not move");
+    assert!(
+        apart < moved * 0.01,
+        "two moves differ from one: {apart} vs {moved}"
+    );
+    assert_eq!(twice.close(), 0);
+    assert_eq!(once.close(), 0);
+}

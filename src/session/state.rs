@@ -254,29 +254,18 @@ impl Loaded {
         if !delta.is_finite() {
             return Err("the node's old matrix cannot be undone (singular)".into());
         }
-        let mut geometry = false;
-        for mi in 0..self.source.meshes.len() {
-            if self.origins.mesh_node[mi] == Some(ni) {
-                let m = &self.source.meshes[mi];
-                let mut object = m.attrs.object.clone();
-                object.location = matrix.transform_point3(glam::Vec3::ZERO);
-                let inst = Instance {
-                    mesh: mi,
-                    to_world: delta,
-                    material: None,
-                    object,
-                };
-                self.source.meshes[mi] = m.placed(&inst);
-                geometry = true;
-            }
-        }
+        let location = matrix.transform_point3(glam::Vec3::ZERO);
+        let mut moved = false;
         for (k, inst) in self.source.instances.iter_mut().enumerate() {
             if self.origins.instance_node[k] == ni {
                 inst.to_world = delta * inst.to_world;
-                inst.object.location = inst.to_world.transform_point3(glam::Vec3::ZERO);
-                geometry = true;
+                inst.object.location = location;
+                moved = true;
             }
         }
+        // A baked mesh becomes an instance of itself: this once the world's BVH is built
+        // again, later moves only place the instance.
+        let unbaked = self.unbake(ni, delta, location);
         if let Some(n) = self.origins.node_world.get_mut(ni) {
             *n = matrix;
         }
@@ -290,12 +279,75 @@ impl Loaded {
         if let Some(light) = light {
             warnings = self.set_lights(ni, matrix, &light)?;
         }
-        if geometry {
+        if unbaked {
             self.rebuild();
+        } else if moved {
+            warnings.extend(self.instances_changed(&[]));
         } else {
             warnings.extend(self.render.refresh_lights());
         }
         Ok(warnings)
+    }
+
+    /// Turns node `ni`'s baked meshes into instances of themselves placed by `delta`, with
+    /// Object Info at `location`. True when there were triangles to move out of the
+    /// world-space BVH (which must then be built again).
+    fn unbake(&mut self, ni: usize, delta: Mat4, location: glam::Vec3) -> bool {
+        let mut any = false;
+        for mi in 0..self.source.meshes.len() {
+            if self.origins.mesh_node[mi] != Some(ni) {
+                continue;
+            }
+            self.origins.mesh_node[mi] = None;
+            let m = &self.source.meshes[mi];
+            if m.indices.is_empty() {
+                continue;
+            }
+            let mut object = m.attrs.object.clone();
+            object.location = location;
+            self.source.instances.push(Instance {
+                mesh: mi,
+                to_world: delta,
+                material: None,
+                object,
+            });
+            self.origins.instance_node.push(ni);
+            any = true;
+        }
+        any
+    }
+
+    /// After instances moved or meshes `changed` (or appended) got new triangles: builds
+    /// only the instances' BVH when no instance emits (emitting instances are baked into
+    /// world space), else everything.
+    fn instances_changed(&mut self, changed: &[usize]) -> Vec<String> {
+        let r = &self.render.scene;
+        let aligned = !self.render.instances_emit()
+            && r.meshes.len() <= self.source.meshes.len()
+            && r.materials.len() == self.source.materials.len();
+        if !aligned {
+            self.rebuild();
+            return Vec::new();
+        }
+        let visible: Vec<Instance> = (self.source.instances.iter())
+            .zip(&self.origins.instance_node)
+            .filter(|(_, n)| !self.hidden.contains(n))
+            .map(|(i, _)| i.clone())
+            .collect();
+        let r = &mut self.render.scene;
+        for &m in changed {
+            if m < r.meshes.len() {
+                r.meshes[m] = self.source.meshes[m].clone();
+            }
+        }
+        let have = r.meshes.len();
+        r.meshes.extend(self.source.meshes[have..].iter().cloned());
+        r.instances = visible;
+        if self.render.instances_emit() {
+            self.rebuild();
+            return Vec::new();
+        }
+        self.render.refresh_instances(changed)
     }
 
     /// Writes world matrix `m` as node `ni`'s matrix in the document (relative to its parent).
@@ -487,10 +539,10 @@ impl Loaded {
             self.hidden.insert(ni)
         };
         if changed {
-            let geometry = self.origins.mesh_node.contains(&Some(ni))
-                || self.origins.instance_node.contains(&ni);
-            if geometry {
+            if self.origins.mesh_node.contains(&Some(ni)) {
                 self.rebuild();
+            } else if self.origins.instance_node.contains(&ni) {
+                self.instances_changed(&[]);
             } else {
                 self.render.scene.lights = self.visible_lights();
                 self.render.refresh_lights();
@@ -547,33 +599,34 @@ impl Loaded {
                 ..m.clone()
             })
             .collect();
+        // Baked meshes leave the world-space BVH (built again, this once); the node then
+        // places the new meshes as instances, so a later replacement builds no world BVH.
+        let mut placements: Vec<(usize, Instance)> = Vec::new();
+        let mut world_changed = false;
         for &ni in &users {
             let world = self.origins.node_world.get(ni).copied().unwrap_or_default();
-            // Baked meshes: emptied, the new ones baked by the node's matrix.
             let mut object = None;
             for mi in 0..self.source.meshes.len() {
                 if self.origins.mesh_node[mi] == Some(ni) {
+                    self.origins.mesh_node[mi] = None;
                     let m = &mut self.source.meshes[mi];
                     object.get_or_insert(m.attrs.object.clone());
+                    world_changed |= !m.indices.is_empty();
                     m.indices = Vec::new();
                     m.positions = Vec::new();
                 }
             }
             if let Some(object) = object {
-                for m in &new_meshes {
-                    let inst = Instance {
-                        mesh: 0,
-                        to_world: world,
-                        material: None,
-                        object: object.clone(),
-                    };
-                    self.source.meshes.push(m.placed(&inst));
-                    self.origins.mesh_node.push(Some(ni));
-                }
+                let inst = Instance {
+                    mesh: 0,
+                    to_world: world,
+                    material: None,
+                    object,
+                };
+                placements.push((ni, inst));
             }
         }
         // Instanced meshes: each placement of a user node places the new meshes instead.
-        let mut placements: Vec<(usize, Instance)> = Vec::new();
         let mut old_meshes = HashSet::new();
         let mut kept = Vec::new();
         let mut kept_nodes = Vec::new();
@@ -595,8 +648,8 @@ impl Loaded {
                 kept_nodes.push(n);
             }
         }
+        let first = self.source.meshes.len();
         if !placements.is_empty() {
-            let first = self.source.meshes.len();
             for m in &new_meshes {
                 self.source.meshes.push(m.clone());
                 self.origins.mesh_node.push(None);
@@ -619,7 +672,13 @@ impl Loaded {
             self.source.instances = kept;
             self.origins.instance_node = kept_nodes;
         }
-        self.rebuild();
+        let mut warnings = warnings;
+        if world_changed {
+            self.rebuild();
+        } else {
+            let changed: Vec<usize> = (first..self.source.meshes.len()).collect();
+            warnings.extend(self.instances_changed(&changed));
+        }
         Ok(warnings)
     }
 }
