@@ -30,6 +30,7 @@ struct Image {
     height: u32,
     samples: u32,
     last: bool,
+    denoised: bool,
     pixels: Vec<f32>,
 }
 
@@ -48,6 +49,7 @@ impl Image {
             height: h,
             samples: u(9),
             last: u(10) & 1 != 0,
+            denoised: u(10) & 2 != 0,
             pixels,
         }
     }
@@ -98,8 +100,13 @@ struct Session {
 
 impl Session {
     fn start() -> Session {
+        Self::start_with(&[])
+    }
+
+    fn start_with(extra: &[&str]) -> Session {
         let mut child = Command::new(env!("CARGO_BIN_EXE_tesela"))
             .args(["session", "--threads", "2"])
+            .args(extra)
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
@@ -706,4 +713,65 @@ fn moving_an_object_twice_lands_where_one_move_does() {
     );
     assert_eq!(twice.close(), 0);
     assert_eq!(once.close(), 0);
+}
+
+/// pyoidn's library folder in the checkout's `.venv`, if installed there (as tests/denoise.rs).
+fn checkout_wheel() -> Option<PathBuf> {
+    let lib = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/lib");
+    std::fs::read_dir(lib)
+        .ok()?
+        .flatten()
+        .map(|e| e.path().join("site-packages/pyoidn/oidn/lib"))
+        .find(|d| d.is_dir())
+}
+
+#[test]
+fn the_viewport_denoiser_denoises_what_is_sent() {
+    let explicit = std::env::var_os(tesela::denoise::ENV_VAR)
+        .is_none()
+        .then(checkout_wheel)
+        .flatten();
+    if let Err(e) = tesela::denoise::Denoiser::load(explicit.as_deref(), 1) {
+        eprintln!("SKIPPED (no Open Image Denoise): {e}");
+        return;
+    }
+    let dir = folder("denoise");
+    let path = scene(&dir);
+    let lib = explicit.map(|p| p.display().to_string());
+    let args: Vec<&str> = lib
+        .iter()
+        .flat_map(|l| ["--oidn-lib", l.as_str()])
+        .collect();
+    let run = |denoise: bool| {
+        let mut s = Session::start_with(&args);
+        s.send(json!({"cmd": "settings", "samples": 4, "denoise": denoise}));
+        s.send(json!({"cmd": "load", "path": path}));
+        s.send(view(64, 64, 1.94));
+        let (im, _, errors) = s.finish(3);
+        assert!(errors.is_empty(), "{errors:?}");
+        assert_eq!(s.close(), 0);
+        im
+    };
+    let (noisy, clean) = (run(false), run(true));
+    assert!(
+        !noisy.denoised && clean.denoised,
+        "flag bit 1 must say denoised"
+    );
+    assert!(clean.pixels.iter().all(|v| v.is_finite()));
+    // Denoising smooths the noise away but keeps the light: neighbours agree more, the
+    // mean stays.
+    let roughness = |im: &Image| {
+        (im.pixels
+            .chunks_exact(4)
+            .zip(im.pixels.chunks_exact(4).skip(1)))
+        .map(|(a, b)| (a[1] - b[1]).abs() as f64)
+        .sum::<f64>()
+    };
+    eprintln!(
+        "roughness {:.1} -> {:.1}",
+        roughness(&noisy),
+        roughness(&clean)
+    );
+    assert!(roughness(&clean) < 0.85 * roughness(&noisy));
+    assert!((clean.mean(1) / noisy.mean(1) - 1.0).abs() < 0.05);
 }

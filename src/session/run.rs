@@ -14,6 +14,8 @@ use serde_json::{Value, json};
 use super::protocol::{self, Command, CommandError, Envelope, ImageHeader};
 use super::schedule;
 use super::state::{Effect, State};
+use crate::denoise::Denoiser;
+use crate::film::{Pass, PassSet};
 use crate::render::{Progressive, RenderError, Sampling};
 
 /// How the session was started.
@@ -107,6 +109,7 @@ impl Job {
         pool: &rayon::ThreadPool,
         threads: usize,
         cancel: &AtomicBool,
+        denoiser: Option<&Denoiser>,
     ) -> Result<Option<Picture>, RenderError> {
         let (Some(loaded), Some(view)) = (&state.loaded, &state.view) else {
             self.done = true;
@@ -144,9 +147,13 @@ impl Job {
             let h = header(d, img.width, img.height, 1, flags, window);
             return Ok(Some((h, img.pixels)));
         }
-        let (opts, window) = state
+        let (mut opts, window) = state
             .render_options(pixel_size, threads)
             .ok_or(RenderError::Cancelled)?;
+        if denoiser.is_some() {
+            // The guides OIDN takes: the first surfaces' albedo and normal.
+            opts.passes = PassSet::new([Pass::DenoisingAlbedo, Pass::DenoisingNormal]);
+        }
         if self.film.is_none() {
             self.film = Some(Progressive::new(scene, &opts, Sampling::Sobol)?);
         }
@@ -156,12 +163,18 @@ impl Job {
             return Ok(None);
         };
         film.round(scene, end, pool, cancel)?;
-        let img = film.image();
+        let mut img = film.image();
         let last = target != 0 && end >= target;
         if last {
             self.done = true;
         }
-        let flags = if last { protocol::FLAG_FINAL } else { 0 };
+        let mut flags = if last { protocol::FLAG_FINAL } else { 0 };
+        // The film stays noisy and refines on; what is sent is denoised.
+        if let Some(d) = denoiser
+            && img.denoise(d, true).is_ok()
+        {
+            flags |= protocol::FLAG_DENOISED;
+        }
         let h = header(pixel_size, img.width, img.height, end, flags, window);
         Ok(Some((h, img.pixels)))
     }
@@ -229,6 +242,8 @@ pub fn run(
         }
     };
     let mut state = State::default();
+    // Loaded the first time `denoise` is asked for; `Err`: it cannot be (said once).
+    let mut denoiser: Option<Result<Denoiser, String>> = None;
     let mut job: Option<Job> = None;
     let mut paused = false;
     loop {
@@ -294,6 +309,24 @@ pub fn run(
         if restart || job.is_none() {
             job = Some(Job::new(&state));
         }
+        if state.settings.denoise && denoiser.is_none() {
+            let d = Denoiser::load(opts.oidn_lib.as_deref(), threads).map_err(|e| e.to_string());
+            match &d {
+                Ok(d) => out.log(
+                    protocol::LOG_INFO,
+                    &format!("denoising with {}", d.describe()),
+                ),
+                Err(e) => out.log(
+                    protocol::LOG_WARNING,
+                    &format!("{e}; the viewport is not denoised"),
+                ),
+            }
+            denoiser = Some(d);
+        }
+        let use_denoiser = match &denoiser {
+            Some(Ok(d)) if state.settings.denoise => Some(d),
+            _ => None,
+        };
         if paused {
             stats(&mut out, &state, job.as_ref(), "paused");
             continue;
@@ -302,7 +335,7 @@ pub fn run(
         if j.done {
             continue;
         }
-        match j.step(&state, &pool, threads, &interrupt) {
+        match j.step(&state, &pool, threads, &interrupt, use_denoiser) {
             Ok(Some((header, pixels))) => {
                 out.frame(protocol::IMAGE, &protocol::image(&header, &pixels));
                 let s = if j.done { "done" } else { "rendering" };
