@@ -425,19 +425,21 @@ impl RenderScene {
     /// now: false when a material of an instance starts or stops emitting (instances that
     /// emit are baked into world space: the BVH must be built again, by [`RenderScene::new`]).
     pub fn shading_keeps_geometry(&self) -> bool {
-        let placed = self.scene.placed_meshes();
+        let mut checked: std::collections::HashMap<usize, bool> = Default::default();
         self.scene.instances.iter().all(|i| {
             let Some(mesh) = self.scene.meshes.get(i.mesh) else {
                 return true;
             };
             let m = i.material.unwrap_or(mesh.material);
-            let old = self.programs.get(m).is_some_and(|p| p.may_emit());
-            let new = (self.scene.materials.get(m)).is_some_and(|mat| {
-                crate::shading::material_program(mat, &self.scene.textures)
-                    .program
-                    .may_emit()
-            });
-            old == new && placed[i.mesh]
+            *checked.entry(m).or_insert_with(|| {
+                let old = self.programs.get(m).is_some_and(|p| p.may_emit());
+                let new = (self.scene.materials.get(m)).is_some_and(|mat| {
+                    crate::shading::material_program(mat, &self.scene.textures)
+                        .program
+                        .may_emit()
+                });
+                old == new
+            })
         })
     }
 

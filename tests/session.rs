@@ -31,6 +31,8 @@ struct Image {
     samples: u32,
     last: bool,
     denoised: bool,
+    /// `[x, y, w, h]` of the view.
+    window: [u32; 4],
     pixels: Vec<f32>,
 }
 
@@ -50,6 +52,7 @@ impl Image {
             samples: u(9),
             last: u(10) & 1 != 0,
             denoised: u(10) & 2 != 0,
+            window: [u(2), u(3), u(4), u(5)],
             pixels,
         }
     }
@@ -774,4 +777,45 @@ fn the_viewport_denoiser_denoises_what_is_sent() {
     );
     assert!(roughness(&clean) < 0.85 * roughness(&noisy));
     assert!((clean.mean(1) / noisy.mean(1) - 1.0).abs() < 0.05);
+}
+
+#[test]
+fn sigterm_ends_the_session_at_once() {
+    let (mut s, _dir, _) = started("sigterm", 1);
+    s.send(json!({"cmd": "settings", "samples": 0}));
+    s.send(view(128, 128, 1.94));
+    while s.next().is_some_and(|(k, _)| k != IMAGE) {}
+    // SAFETY: sends a signal to the child this test started.
+    let r = unsafe { libc::kill(s.child.id() as libc::pid_t, libc::SIGTERM) };
+    assert_eq!(r, 0);
+    let t = Instant::now();
+    let status = loop {
+        if let Some(st) = s.child.try_wait().unwrap() {
+            break st;
+        }
+        assert!(t.elapsed() < DEADLINE, "no exit after SIGTERM");
+        std::thread::sleep(Duration::from_millis(5));
+    };
+    assert_eq!(status.code(), Some(130));
+}
+
+#[test]
+fn a_border_renders_the_same_pixels_as_that_part_of_the_view() {
+    let (mut s, _dir, full) = started("border", 2);
+    let mut v = view(48, 36, 1.94);
+    v["border"] = json!([10, 7, 21, 17]);
+    s.send(v);
+    let (im, images, errors) = s.finish(4);
+    assert!(errors.is_empty(), "{errors:?}");
+    assert_eq!(im.window, [10, 7, 21, 17]);
+    assert_eq!((im.width, im.height, im.pixel_size), (21, 17, 1));
+    assert!(images.iter().all(|i| i.window == [10, 7, 21, 17]));
+    for y in 0..17 {
+        for x in 0..21 {
+            let a = ((y * 21 + x) * 4) as usize;
+            let b = (((y + 7) * 48 + x + 10) * 4) as usize;
+            assert_eq!(im.pixels[a..a + 4], full.pixels[b..b + 4], "pixel {x} {y}");
+        }
+    }
+    assert_eq!(s.close(), 0);
 }

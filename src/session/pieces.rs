@@ -15,6 +15,9 @@ use crate::scene::{Camera, Image, Light, Material, Scene, TexRef, Texture, World
 /// The 3 vertices of the triangle that carries a material through the loader.
 const TRIANGLE: [[f32; 3]; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
 
+/// UV sets the carrier triangle has (so a textured material finds the set it reads).
+const CARRIER_UV_SETS: usize = 4;
+
 /// Name of that triangle's mesh (its warnings are not the material's).
 const CARRIER: &str = "tesela-session-carrier";
 
@@ -131,6 +134,16 @@ fn shared_members(doc: &Document, extra_len: usize) -> (Map<String, Value>, usiz
         json!({"bufferView": view, "componentType": 5126, "count": 3, "type": "VEC3",
                "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 0.0]}),
     );
+    if extra_len >= 36 + CARRIER_UV_SETS * 24 {
+        for k in 0..CARRIER_UV_SETS {
+            push(
+                &mut m,
+                "accessors",
+                json!({"bufferView": view, "byteOffset": 36 + 24 * k, "componentType": 5126,
+                       "count": 3, "type": "VEC2"}),
+            );
+        }
+    }
     (m, view, accessor)
 }
 
@@ -163,7 +176,7 @@ pub fn material(doc: &Document, material: &Value) -> Result<(Scene, Vec<String>)
 
 /// World JSON `world` (a `TESELA_world` object) read against `doc`'s images.
 pub fn world(doc: &Document, world: &Value) -> Result<(Scene, Vec<String>), String> {
-    let pad = [0u8; 4];
+    let pad = [0u8; 36];
     let (mut m, _, _) = shared_members(doc, pad.len());
     let ext = m.entry("extensions").or_insert_with(|| json!({}));
     if let Some(e) = ext.as_object_mut() {

@@ -531,6 +531,48 @@ mod tests {
     }
 
     #[test]
+    fn garbage_never_panics() {
+        // A fixed-seed stream of random payloads, some of them JSON-looking.
+        let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let words: [&[u8]; 8] = [
+            b"{",
+            b"}",
+            b"\"cmd\":",
+            b"\"view\"",
+            b"[",
+            b"]",
+            b"1e999",
+            b",",
+        ];
+        let mut refused = 0;
+        for _ in 0..20000 {
+            let mut p = Vec::new();
+            let n = next() % 40;
+            for _ in 0..n {
+                let r = next();
+                if r % 3 == 0 {
+                    p.extend_from_slice(words[(r >> 8) as usize % words.len()]);
+                } else {
+                    p.push((r >> 16) as u8);
+                }
+            }
+            let mut framed = (p.len() as u32).to_le_bytes().to_vec();
+            framed.extend_from_slice(&p);
+            refused += parse_command(COMMAND, &framed).is_err() as u32;
+            let _ = parse_command(COMMAND, &p);
+            let _ = read_frame(&mut &p[..]);
+        }
+        // Random bytes are almost never a command: each is answered as an error.
+        assert!(refused > 19_900, "{refused}");
+    }
+
+    #[test]
     fn frames_read_back_and_truncation_is_an_error() {
         let mut buf = Vec::new();
         write_frame(&mut buf, COMMAND, b"abc").unwrap();
