@@ -819,3 +819,56 @@ fn a_border_renders_the_same_pixels_as_that_part_of_the_view() {
     }
     assert_eq!(s.close(), 0);
 }
+
+#[test]
+fn a_textured_material_edit_keeps_its_texture() {
+    // The Khronos samples beside the checkout, as tests/gltf_samples.rs finds them.
+    let file = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/gltf-samples/BoxTextured/glTF/BoxTextured.gltf");
+    if !file.exists() {
+        eprintln!("SKIPPED: no glTF samples ({})", file.display());
+        return;
+    }
+    let mut s = Session::start();
+    s.send(json!({"cmd": "settings", "samples": 2, "start_resolution": 16}));
+    s.send(json!({"cmd": "load", "path": file}));
+    s.send(json!({"cmd": "world", "world": {"color": [1.0, 1.0, 1.0], "strength": 1.0}}));
+    let m = vec![
+        0.8f32, 0.0, -0.6, 0.0, -0.3, 0.87, -0.4, 0.0, 0.52, 0.5, 0.7, 0.0, 1.3, 1.2, 1.7, 1.0,
+    ];
+    s.send(json!({"cmd": "view", "width": 40, "height": 40,
+                  "camera": {"matrix": m, "camera": tesela_camera()}}));
+    let (a, _, errors) = s.finish(4);
+    assert!(errors.is_empty(), "{errors:?}");
+    // The box fills part of the view, lit by the world, with the logo's colours.
+    let covered = a
+        .pixels
+        .chunks_exact(4)
+        .filter(|p| (p[0] - 1.0).abs() > 0.05)
+        .count();
+    eprintln!(
+        "pixels not the bare sky: {covered} of 1600; mean {:.3} {:.3} {:.3}",
+        a.mean(0),
+        a.mean(1),
+        a.mean(2)
+    );
+    assert!(covered > 200, "the box is not in view");
+    let textured = json!({"name": "Texture", "pbrMetallicRoughness":
+        {"baseColorTexture": {"index": 0}, "metallicFactor": 0.0}});
+    s.send(json!({"cmd": "material", "name": "Texture", "material": textured}));
+    let (same, _, errors) = s.finish(5);
+    assert!(errors.is_empty(), "{errors:?}");
+    assert_eq!(
+        max_diff(&same, &a),
+        0.0,
+        "the same material JSON must render the same"
+    );
+    s.send(json!({"cmd": "material", "name": "Texture", "material":
+        {"name": "Texture", "pbrMetallicRoughness": {"metallicFactor": 0.0}}}));
+    let (plain, _, _) = s.finish(6);
+    assert!(max_diff(&plain, &a) > 0.1, "the texture did not go away");
+    s.send(json!({"cmd": "material", "name": "Texture", "material": textured}));
+    let (back, _, _) = s.finish(7);
+    assert_eq!(max_diff(&back, &a), 0.0, "the texture did not come back");
+    assert_eq!(s.close(), 0);
+}
