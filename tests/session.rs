@@ -872,3 +872,14 @@ fn a_textured_material_edit_keeps_its_texture() {
     assert_eq!(max_diff(&back, &a), 0.0, "the texture did not come back");
     assert_eq!(s.close(), 0);
 }
+
+#[test]
+fn a_broken_framing_is_fatal_with_status_two() {
+    let (mut s, _dir, _) = started("framing", 1);
+    // A header announcing 4 GiB: no reader can find the next frame after it.
+    s.send_raw(&[32, 0, 0, 0, 255, 255, 255, 255]);
+    let e = s.error();
+    assert_eq!(e["fatal"], json!(true), "{e}");
+    assert!(e["message"].as_str().unwrap().contains("framing"), "{e}");
+    assert_eq!(s.close(), 2);
+}

@@ -1,5 +1,5 @@
 //! The session loop: a reader thread turns stdin into commands on a channel (raising a flag
-//! the render polls before every tile row, so a command cancels the pass in flight), and the
+//! the render polls before every pixel, so a command cancels the pass in flight), and the
 //! loop applies every queued command (views coalesced: only the newest is applied), then
 //! renders the next progressive pass and writes it as an IMAGE frame.
 
@@ -201,15 +201,18 @@ pub fn run(
                     Ok(None) => Incoming::End,
                     Err(e) => Incoming::Broken(e.to_string()),
                 };
-                let last = !matches!(msg, Incoming::Command(_));
+                let code = match msg {
+                    Incoming::Command(_) => None,
+                    Incoming::End => Some(0),
+                    Incoming::Broken(_) => Some(2),
+                };
                 let sent = tx.send(msg).is_ok();
                 interrupt.store(true, Ordering::SeqCst);
-                if last || !sent {
-                    break;
+                if code.is_some() || !sent {
+                    std::thread::sleep(EOF_GRACE);
+                    std::process::exit(code.unwrap_or(0));
                 }
             }
-            std::thread::sleep(EOF_GRACE);
-            std::process::exit(0);
         });
     }
     // Signals end the session at once.
