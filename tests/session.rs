@@ -883,3 +883,68 @@ fn a_broken_framing_is_fatal_with_status_two() {
     assert!(e["message"].as_str().unwrap().contains("framing"), "{e}");
     assert_eq!(s.close(), 2);
 }
+
+/// The test scene with the short block's mesh placed a second time, by node `copy` at `x`.
+fn scene_with_copy(dir: &Path, x: f32) -> PathBuf {
+    let path = scene(dir);
+    let mut doc: Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    let mesh = doc["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|n| n["name"] == "short block")
+        .unwrap()["mesh"]
+        .clone();
+    let m = json!([
+        1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, x, 0.0, 0.35, 1.0
+    ]);
+    doc["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"name": "copy", "mesh": mesh, "matrix": m}));
+    let n = doc["nodes"].as_array().unwrap().len() - 1;
+    doc["scenes"][0]["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!(n));
+    std::fs::write(&path, doc.to_string()).unwrap();
+    path
+}
+
+#[test]
+fn moving_an_instance_equals_loading_it_moved() {
+    // A mesh placed by two nodes is instanced at load: moving one node only places it again.
+    let run = |name: &str, x_file: f32, x_moved: Option<f32>| {
+        let path = scene_with_copy(&folder(name), x_file);
+        let mut s = Session::start();
+        s.send(json!({"cmd": "settings", "samples": 2, "start_resolution": 16}));
+        s.send(json!({"cmd": "load", "path": path}));
+        s.send(view(48, 36, 1.94));
+        let mut generation = 3;
+        if let Some(x) = x_moved {
+            let m = json!([
+                1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, x, 0.0, 0.35, 1.0
+            ]);
+            s.send(json!({"cmd": "transform", "node": "copy", "matrix": m}));
+            generation += 1;
+        }
+        let (im, _, errors) = s.finish(generation);
+        assert!(errors.is_empty(), "{errors:?}");
+        assert_eq!(s.close(), 0);
+        im
+    };
+    let (before, moved, file) = (
+        run("inst-before", -0.6, None),
+        run("inst-moved", -0.6, Some(0.55)),
+        run("inst-file", 0.55, None),
+    );
+    assert!(
+        max_diff(&moved, &before) > 0.05,
+        "the instance did not move"
+    );
+    assert_eq!(
+        max_diff(&moved, &file),
+        0.0,
+        "moved instance differs from the file's"
+    );
+}

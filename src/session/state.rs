@@ -258,7 +258,13 @@ impl Loaded {
         let mut moved = false;
         for (k, inst) in self.source.instances.iter_mut().enumerate() {
             if self.origins.instance_node[k] == ni {
-                inst.to_world = delta * inst.to_world;
+                // A plain placement is the node's matrix itself: take the new one exactly
+                // (as a file with it would); one of several instances of a node moves along.
+                inst.to_world = if inst.to_world == old {
+                    matrix
+                } else {
+                    delta * inst.to_world
+                };
                 inst.object.location = location;
                 moved = true;
             }
