@@ -485,6 +485,14 @@ impl RenderScene {
         self.refresh_shading()
     }
 
+    /// Takes world-space meshes out of the world's BVH without building it again (see
+    /// [`Accel::remove_mesh`]): for a mesh that instances place from now on.
+    pub fn remove_world_meshes(&mut self, meshes: &[usize]) {
+        for &m in meshes {
+            self.accel.remove_mesh(m as u32);
+        }
+    }
+
     /// Rebuilds the emitters only (lights or the world changed; the materials did not).
     pub fn refresh_lights(&mut self) -> Vec<String> {
         let mut warnings = Vec::new();

@@ -269,8 +269,9 @@ impl Loaded {
                 moved = true;
             }
         }
-        // A baked mesh becomes an instance of itself: this once the world's BVH is built
-        // again, later moves only place the instance.
+        // A baked mesh becomes an instance of itself: its triangles are made unhittable in
+        // the world's BVH (no rebuild) and its own bottom level is built once; later moves
+        // only place the instance.
         let unbaked = self.unbake(ni, delta, location);
         if let Some(n) = self.origins.node_world.get_mut(ni) {
             *n = matrix;
@@ -285,8 +286,8 @@ impl Loaded {
         if let Some(light) = light {
             warnings = self.set_lights(ni, matrix, &light)?;
         }
-        if unbaked {
-            self.rebuild();
+        if !unbaked.is_empty() {
+            warnings.extend(self.out_of_world(&unbaked, &unbaked));
         } else if moved {
             warnings.extend(self.instances_changed(&[]));
         } else {
@@ -296,10 +297,10 @@ impl Loaded {
     }
 
     /// Turns node `ni`'s baked meshes into instances of themselves placed by `delta`, with
-    /// Object Info at `location`. True when there were triangles to move out of the
-    /// world-space BVH (which must then be built again).
-    fn unbake(&mut self, ni: usize, delta: Mat4, location: glam::Vec3) -> bool {
-        let mut any = false;
+    /// Object Info at `location`; the meshes that had triangles (to take out of the
+    /// world-space BVH).
+    fn unbake(&mut self, ni: usize, delta: Mat4, location: glam::Vec3) -> Vec<usize> {
+        let mut moved = Vec::new();
         for mi in 0..self.source.meshes.len() {
             if self.origins.mesh_node[mi] != Some(ni) {
                 continue;
@@ -318,9 +319,22 @@ impl Loaded {
                 object,
             });
             self.origins.instance_node.push(ni);
-            any = true;
+            moved.push(mi);
         }
-        any
+        moved
+    }
+
+    /// World-space meshes `removed` leave the world's BVH in place (no rebuild) and the
+    /// instances now placing meshes `changed` are built (their bottom levels and the top).
+    fn out_of_world(&mut self, removed: &[usize], changed: &[usize]) -> Vec<String> {
+        if self.render.instances_emit() {
+            self.rebuild();
+            return Vec::new();
+        }
+        self.render.remove_world_meshes(removed);
+        let mut both = removed.to_vec();
+        both.extend(changed.iter().filter(|m| !removed.contains(m)));
+        self.instances_changed(&both)
     }
 
     /// After instances moved or meshes `changed` (or appended) got new triangles: builds
@@ -605,10 +619,10 @@ impl Loaded {
                 ..m.clone()
             })
             .collect();
-        // Baked meshes leave the world-space BVH (built again, this once); the node then
-        // places the new meshes as instances, so a later replacement builds no world BVH.
+        // Baked meshes leave the world-space BVH (made unhittable in place); the node then
+        // places the new meshes as instances: no replacement builds the world BVH again.
         let mut placements: Vec<(usize, Instance)> = Vec::new();
-        let mut world_changed = false;
+        let mut removed = Vec::new();
         for &ni in &users {
             let world = self.origins.node_world.get(ni).copied().unwrap_or_default();
             let mut object = None;
@@ -617,7 +631,9 @@ impl Loaded {
                     self.origins.mesh_node[mi] = None;
                     let m = &mut self.source.meshes[mi];
                     object.get_or_insert(m.attrs.object.clone());
-                    world_changed |= !m.indices.is_empty();
+                    if !m.indices.is_empty() {
+                        removed.push(mi);
+                    }
                     m.indices = Vec::new();
                     m.positions = Vec::new();
                 }
@@ -679,12 +695,8 @@ impl Loaded {
             self.origins.instance_node = kept_nodes;
         }
         let mut warnings = warnings;
-        if world_changed {
-            self.rebuild();
-        } else {
-            let changed: Vec<usize> = (first..self.source.meshes.len()).collect();
-            warnings.extend(self.instances_changed(&changed));
-        }
+        let changed: Vec<usize> = (first..self.source.meshes.len()).collect();
+        warnings.extend(self.out_of_world(&removed, &changed));
         Ok(warnings)
     }
 }
