@@ -385,7 +385,9 @@ fn every_command_changes_what_it_should() {
         "the world did not change"
     );
 
-    // Hiding and showing an object: showing restores the very same pixels.
+    // Hiding and showing an object: showing restores the image. Hiding made the baked block
+    // an instance of itself at an identity placement (so a toggle rebuilds only the top
+    // level): its hits are the same up to rounding in the last bit (measured 1.2e-7).
     let hidden = step(
         &mut s,
         json!({"cmd": "visibility", "node": "short block", "visible": false}),
@@ -395,11 +397,8 @@ fn every_command_changes_what_it_should() {
         &mut s,
         json!({"cmd": "visibility", "node": "short block", "visible": true}),
     );
-    assert_eq!(
-        max_diff(&shown, &sky),
-        0.0,
-        "showing again must restore the image"
-    );
+    let back = max_diff(&shown, &sky);
+    assert!(back < 1e-5, "showing again must restore the image ({back})");
 
     // Replacing a mesh.
     let file = mesh_file(&dir, "short block");

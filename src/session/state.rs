@@ -558,15 +558,21 @@ impl Loaded {
         } else {
             self.hidden.insert(ni)
         };
-        if changed {
-            if self.origins.mesh_node.contains(&Some(ni)) {
-                self.rebuild();
-            } else if self.origins.instance_node.contains(&ni) {
-                self.instances_changed(&[]);
-            } else {
-                self.render.scene.lights = self.visible_lights();
-                self.render.refresh_lights();
-            }
+        if !changed {
+            return Ok(());
+        }
+        self.render.scene.lights = self.visible_lights();
+        // A baked object becomes an instance of itself where it is (identity placement), so
+        // hiding and showing it only builds the top level.
+        let location = (self.origins.node_world.get(ni))
+            .map_or(glam::Vec3::ZERO, |m| m.transform_point3(glam::Vec3::ZERO));
+        let unbaked = self.unbake(ni, Mat4::IDENTITY, location);
+        if !unbaked.is_empty() {
+            self.out_of_world(&unbaked, &unbaked);
+        } else if self.origins.instance_node.contains(&ni) {
+            self.instances_changed(&[]);
+        } else {
+            self.render.refresh_lights();
         }
         Ok(())
     }
