@@ -477,6 +477,10 @@ impl Loaded {
                 e.insert("TESELA_light".into(), light.clone());
             }
         }
+        if self.origins.node_world.len() <= ni {
+            // A node the walk never reached (not in the scene's tree).
+            self.origins.node_world.resize(ni + 1, Mat4::IDENTITY);
+        }
         self.origins.node_world[ni] = matrix;
         self.set_raw_matrix(ni, matrix);
         let mut w = warnings;
