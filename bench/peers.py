@@ -741,6 +741,79 @@ def clean_bench(args):
     return text
 
 
+def equal_time_bench(args):
+    """Equal-time error through the add-on, plain Monte Carlo on both sides (fixed spp, no noise
+    threshold, no denoiser): Cycles renders `--addon-spp` samples; Tesela's spp is chosen from two
+    calibration renders (1 and that spp) so that its wall time, export and process start included,
+    matches Cycles' median; each is compared with its own `--clean-ref-spp` reference (relMSE
+    corrected for the reference's own noise, which is the error at spp scaled by spp / ref spp)."""
+    import bpy
+    import importlib
+    tests = REPO / "tests" / "blender"
+    for path in (REPO, tests):
+        sys.path.insert(0, str(path))
+    sys.modules.pop("scenes", None)
+    import blender_addon
+    import scenes as bs
+    from blender_addon import engine as tesela_engine
+    if not tesela_engine.TeselaRenderEngine.is_registered:
+        blender_addon.register()
+    os.environ["TESELA_BINARY"] = str(args.tesela)
+    size = args.size or (48 if args.quick else 128)
+    ref_spp = 64 if args.quick else args.clean_ref_spp
+    spp = 4 if args.quick else args.addon_spp
+    repeats = args.repeats or (2 if args.quick else 3)
+    bounces = 3
+    lines = [f"#### Equal time through the add-on: {size}x{size}, Cycles {spp} spp, max bounces "
+             f"{bounces} / Tesela path_mis depth {bounces + 2}, {args.threads} threads; relMSE against "
+             f"each renderer's own {ref_spp} spp reference (its noise removed)", "",
+             "| scene | peer | spp | median wall s | relMSE | mean RGB |",
+             "| --- | --- | --- | --- | --- | --- |"]
+    ratios = {}
+    for name in [n.strip() for n in args.addon_scenes.split(",") if n.strip()]:
+        module, builder = ADDON_SCENES[name]
+        bs.clear_scene()
+        getattr(importlib.import_module(module), builder)()
+        sc = bpy.context.scene
+        bs.configure_cycles(sc, size, size, ref_spp, bounces, seed=1, threads=args.threads)
+        t = sc.tesela
+        bs.tesela_like_cycles(t)
+        t.integrator, t.max_depth, t.threads = "path_mis", bounces + 2, args.threads
+        ref = {}
+        for peer, engine in (("cycles", "CYCLES"), ("tesela", "TESELA")):
+            _addon_render(engine, ref_spp, 7)
+            ref[peer] = _render_result_image()
+        ones = [_addon_render("TESELA", 1, 100 + r) for r in range(repeats)]
+        fulls = [_addon_render("TESELA", spp, 200 + r) for r in range(repeats)]
+        cyc = []
+        for r in range(repeats):
+            cyc.append((_addon_render("CYCLES", spp, 300 + r), _render_result_image()))
+        t_c = statistics.median(w for w, _ in cyc)
+        t1, ts = statistics.median(ones), statistics.median(fulls)
+        per_sample = max(ts - t1, 1e-9) / max(spp - 1, 1)
+        spp_t = max(1, round(1 + (t_c - t1) / per_sample))
+        tes = []
+        for r in range(repeats):
+            tes.append((_addon_render("TESELA", spp_t, 400 + r), _render_result_image()))
+        row = {}
+        for peer, runs, n in (("cycles", cyc, spp), ("tesela", tes, spp_t)):
+            errs = [rel_mse(img, ref[peer]) / (1 + n / ref_spp) for _, img in runs]
+            wall = statistics.median(w for w, _ in runs)
+            row[peer] = (wall, statistics.median(errs))
+            m = ", ".join(f"{v:.4f}" for v in runs[-1][1].reshape(-1, 3).mean(axis=0))
+            lines.append(f"| {name} | {peer} | {n} | {wall:.2f} | {row[peer][1]:.3e} | {m} |")
+            log(lines[-1])
+        # Scaled to exactly Cycles' wall time (error ~ 1 / time) where the walls differ a little.
+        scaled = row["tesela"][1] * row["tesela"][0] / row["cycles"][0]
+        ratios[name] = scaled / row["cycles"][1]
+    lines.append("")
+    for name, r in ratios.items():
+        lines.append(f"- {name}: Tesela / Cycles relMSE at Cycles' wall time {r:.2f}x")
+    text = "\n".join(lines)
+    log("\n" + text)
+    return text
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="tiny sizes: a smoke run")
@@ -771,16 +844,21 @@ def main():
     ap.add_argument("--clean", action="store_true",
                     help="time to a clean image with each renderer's defaults (adaptive + OIDN)")
     ap.add_argument("--clean-ref-spp", type=int, default=2048)
+    ap.add_argument("--equal-time", action="store_true",
+                    help="Blender scenes through the add-on: relMSE at Cycles' wall time, plain MC")
     args = ap.parse_args()
     if args.merge:
         return merge(args)
-    if args.addon or args.clean:
+    if args.addon or args.clean or args.equal_time:
         import bpy  # noqa: F401
-        text = clean_bench(args) if args.clean else addon_bench(args)
+        if args.equal_time:
+            text = equal_time_bench(args)
+        else:
+            text = clean_bench(args) if args.clean else addon_bench(args)
         if args.out:
             Path(args.out).mkdir(parents=True, exist_ok=True)
             stamp = _dt.datetime.now(_dt.timezone.utc).strftime("%Y%m%d-%H%M")
-            kind = "clean" if args.clean else "addon"
+            kind = "equal-time" if args.equal_time else "clean" if args.clean else "addon"
             (Path(args.out) / f"{kind}-{stamp}.md").write_text(text + "\n")
         return None
     q = args.quick

@@ -13,14 +13,16 @@ bl_info = {
 
 if "bpy" in locals():  # reload support (F3 > Reload Scripts)
     import importlib
-    for _m in (compat, protocol, report, export, properties, preferences, engine, ui):  # noqa: F821
+    for _m in (compat, protocol, process, report, export, properties, preferences,  # noqa: F821
+               viewport, engine, ui):  # noqa: F821
         importlib.reload(_m)
 
 import bpy  # noqa: E402
 
-from . import compat, protocol, report, export, properties, preferences, engine, ui  # noqa: E402,F401
+from . import compat, protocol, process, report, export, properties, preferences  # noqa: E402,F401
+from . import viewport, engine, ui  # noqa: E402
 
-_MODULES = (properties, preferences, engine, ui)
+_MODULES = (properties, preferences, viewport, engine, ui)
 
 
 def register():

@@ -229,7 +229,12 @@ def pass_rect_set(render_pass, flat_rgba):
 
 # Blender 4.2 renamed the short render pass names Cycles registers (IndexOB -> Object Index).
 _PASS_NAMES_4_2 = {"IndexOB": "Object Index", "IndexMA": "Material Index", "Emit": "Emission",
-                   "Env": "Environment"}
+                   "Env": "Environment",
+                   "DiffDir": "Diffuse Direct", "DiffInd": "Diffuse Indirect",
+                   "DiffCol": "Diffuse Color", "GlossDir": "Glossy Direct",
+                   "GlossInd": "Glossy Indirect", "GlossCol": "Glossy Color",
+                   "TransDir": "Transmission Direct", "TransInd": "Transmission Indirect",
+                   "TransCol": "Transmission Color"}
 
 
 def pass_name(name):
@@ -594,3 +599,40 @@ def translate_node(node, entry, index, emit):
         entry["props"]["model"] = "CHIANG"
         return None
     return None
+
+
+# --- viewport drawing ------------------------------------------------------------------------
+# Since Blender 2.91 the 3D viewport keeps a scene-linear colour buffer and applies the view
+# transform, look and exposure itself when it shows the region; an engine's
+# bind_display_space_shader binds Blender's builtin image shader (measured with Blender 3.4:
+# the region's framebuffer holds the texture's linear values, the screen their view transform).
+# Python cannot draw with "the bound shader", so the texture is drawn with that same builtin
+# shader, between the engine's bind/unbind calls as Cycles makes them.
+
+def draw_scene_linear_texture(engine, scene, texture, rect, uv):
+    """Draw `texture` into rect (x, y, w, h; region pixels, bottom-left origin), texture
+    coordinates uv (u0, v0, u1, v1)."""
+    import gpu
+    from gpu_extras.batch import batch_for_shader
+    x, y, w, h = rect
+    u0, v0, u1, v1 = uv
+    shader = gpu.shader.from_builtin("IMAGE")
+    batch = batch_for_shader(  # triangles: Blender 4+ backends have no triangle fans
+        shader, "TRIS",
+        {"pos": ((x, y), (x + w, y), (x + w, y + h), (x, y + h)),
+         "texCoord": ((u0, v0), (u1, v0), (u1, v1), (u0, v1))},
+        indices=((0, 1, 2), (2, 3, 0)))
+    engine.bind_display_space_shader(scene)
+    shader.bind()
+    shader.uniform_sampler("image", texture)
+    batch.draw(shader)
+    engine.unbind_display_space_shader()
+
+
+def blf_size(font, size):
+    """blf.size: Blender 3.x also takes a dpi (deprecated in 3.4, gone in 4.0)."""
+    import blf
+    if VERSION >= (4, 0, 0):
+        blf.size(font, size)
+    else:
+        blf.size(font, size, 72)

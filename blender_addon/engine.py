@@ -1,147 +1,20 @@
 # SPDX-License-Identifier: MIT
 """The Tesela RenderEngine: export -> renderer subprocess -> tiles into the result."""
 
-import collections
 import os
 import queue
 import shutil
-import signal
 import subprocess
-import tempfile
-import threading
 import time
 
 import bpy
 import numpy as np
 
-from . import compat, export, passes, preferences, protocol, report
+from . import compat, export, passes, preferences, protocol, report, viewport
+from .process import StderrTail, _describe_exit, make_tmpdir, stop_process, sweep_stale_tmpdirs
 
 POLL_SECONDS = 0.03        # how often render() looks at the queue and test_break()
 PUSH_SECONDS = 0.25        # how often the render result is refreshed
-STDERR_TAIL_BYTES = 64 * 1024
-STOP_GRACE_SECONDS = 0.15  # stdin closed -> SIGTERM -> SIGKILL, each this long
-
-
-class StderrTail:
-    """Drains a pipe in a thread, keeping only the last `limit` bytes."""
-
-    def __init__(self, pipe, limit=STDERR_TAIL_BYTES):
-        self.pipe = pipe
-        self.limit = limit
-        self.chunks = collections.deque()
-        self.size = 0
-        self.total = 0
-        self.lock = threading.Lock()
-        self.thread = threading.Thread(target=self._run, name="tesela-stderr", daemon=True)
-        self.thread.start()
-
-    def _run(self):
-        fd = self.pipe.fileno()
-        try:
-            while True:
-                chunk = os.read(fd, 65536)
-                if not chunk:
-                    break
-                with self.lock:
-                    self.chunks.append(chunk)
-                    self.size += len(chunk)
-                    self.total += len(chunk)
-                    while self.size > self.limit and len(self.chunks) > 1:
-                        self.size -= len(self.chunks.popleft())
-        except (OSError, ValueError):
-            pass
-
-    def text(self, max_lines=8):
-        with self.lock:
-            data = b"".join(self.chunks)[-self.limit:]
-        lines = [ln for ln in data.decode("utf-8", errors="replace").splitlines() if ln.strip()]
-        return "\n".join(lines[-max_lines:])
-
-
-TMP_PREFIX = "tesela-render-"
-
-
-def make_tmpdir():
-    """A fresh private folder for one render, named after this Blender's pid so that a later
-    render can remove what a killed Blender left behind."""
-    return tempfile.mkdtemp(prefix="%s%d-" % (TMP_PREFIX, os.getpid()))
-
-
-def _pid_alive(pid):
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    try:  # a zombie (dead, not yet reaped) counts as dead
-        with open("/proc/%d/stat" % pid) as f:
-            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
-    except (OSError, IndexError):
-        return True
-
-
-def sweep_stale_tmpdirs():
-    """Remove render folders of Blender processes that no longer exist (killed mid-render)."""
-    base = tempfile.gettempdir()
-    try:
-        names = os.listdir(base)
-    except OSError:
-        return
-    me = os.getpid()
-    uid = os.getuid() if hasattr(os, "getuid") else None
-    for name in names:
-        if not name.startswith(TMP_PREFIX):
-            continue
-        pid = name[len(TMP_PREFIX):].split("-", 1)[0]
-        if not pid.isdigit() or int(pid) == me or _pid_alive(int(pid)):
-            continue
-        path = os.path.join(base, name)
-        try:
-            if uid is not None and os.stat(path).st_uid != uid:
-                continue
-        except OSError:
-            continue
-        shutil.rmtree(path, ignore_errors=True)
-
-
-def _describe_exit(code):
-    if code is None:
-        return "still running"
-    if code < 0:
-        try:
-            return "killed by signal %s" % signal.Signals(-code).name
-        except ValueError:
-            return "killed by signal %d" % -code
-    return "exit code %d" % code
-
-
-def stop_process(proc, grace=STOP_GRACE_SECONDS):
-    """Close stdin, then SIGTERM, then SIGKILL; always reap. Returns the exit code."""
-    if proc is None:
-        return None
-    try:
-        if proc.stdin is not None and not proc.stdin.closed:
-            proc.stdin.close()
-    except OSError:
-        pass
-    for step in ("wait", "terminate", "kill"):
-        if step == "terminate":
-            try:
-                proc.terminate()
-            except OSError:
-                pass
-        elif step == "kill":
-            try:
-                proc.kill()
-            except OSError:
-                pass
-            return proc.wait()
-        try:
-            return proc.wait(timeout=grace)
-        except subprocess.TimeoutExpired:
-            continue
-    return proc.wait()
 
 
 class RenderSession:
@@ -201,6 +74,7 @@ def renderer_args(binary, gltf, settings, width, height, region, pass_names=(), 
             "--seed", str(render_seed(settings, frame))]
     if settings.threads > 0:
         args += ["--threads", str(settings.threads)]
+    args += ["--tile-size", str(settings.tile_size)]
     if region is not None:
         args += ["--region"] + [str(v) for v in region]
     if pass_names:
@@ -258,10 +132,30 @@ class progress_lines:
         return True
 
 
+PREVIEW_SAMPLES_MAX = 64
+
+
+class PreviewSettings:
+    """scene.tesela for a material, light or world preview (the Properties editor's sphere and
+    the icons): the viewport's sample count, at most PREVIEW_SAMPLES_MAX, and no denoiser, so a
+    preview stays a short render in Blender's preview job."""
+
+    def __init__(self, settings):
+        self._settings = settings
+
+    def __getattr__(self, name):
+        if name == "samples":
+            wanted = int(self._settings.preview_samples) or PREVIEW_SAMPLES_MAX
+            return max(1, min(wanted, PREVIEW_SAMPLES_MAX))
+        if name == "use_denoising":
+            return False
+        return getattr(self._settings, name)
+
+
 class TeselaRenderEngine(bpy.types.RenderEngine):
     bl_idname = "TESELA"
     bl_label = "Tesela"
-    bl_use_preview = False
+    bl_use_preview = True
     bl_use_postprocess = True
     bl_use_shading_nodes_custom = False
     bl_use_eevee_viewport = True
@@ -269,6 +163,38 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
     def __init__(self, *args, **kwargs):
         # Blender 4.4+ passes arguments here; older versions pass none.
         super().__init__(*args, **kwargs)
+        self.viewport = None
+
+    def __del__(self):
+        # Blender frees a viewport's engine when Rendered shading ends, the area closes or the
+        # engine changes: the session process ends with it.
+        vs = getattr(self, "viewport", None)
+        if vs is not None:
+            vs.close()
+
+    # -- viewport -----------------------------------------------------------------------------
+
+    def view_update(self, context, depsgraph):
+        if self.viewport is None:
+            self.viewport = viewport.new_session(self)
+        try:
+            self.viewport.update(self, context, depsgraph)
+        except Exception as exc:  # noqa: BLE001 - never take Blender down, always say why
+            import traceback
+            traceback.print_exc()
+            self.viewport.message = "internal error in the add-on: %s: %s" % (
+                type(exc).__name__, exc)
+
+    def view_draw(self, context, depsgraph):
+        if self.viewport is None:
+            return
+        try:
+            self.viewport.draw(self, context, depsgraph)
+        except Exception as exc:  # noqa: BLE001
+            import traceback
+            traceback.print_exc()
+            self.viewport.message = "internal error in the add-on: %s: %s" % (
+                type(exc).__name__, exc)
 
     # -- helpers --------------------------------------------------------------
 
@@ -299,7 +225,7 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
     def render(self, depsgraph):
         scene = depsgraph.scene
         r = scene.render
-        settings = scene.tesela
+        settings = PreviewSettings(scene.tesela) if self.is_preview else scene.tesela
         width, height = export.render_size(r)
         region = export.border_region(r, width, height)
         _, _, rw, rh = region if region is not None else (0, 0, width, height)
@@ -386,9 +312,11 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
                 continue
             pass_names.append(name)
             pass_targets[bname] = (rp, np.zeros((rh, rw, len(ids)), dtype=np.float32))
-        left_out = passes.unsupported(depsgraph.view_layer)
+        left_out = [compat.pass_name(n) for n in passes.unsupported(depsgraph.view_layer, settings)]
         if left_out:
             message = "Tesela does not render these passes yet (left empty): " + ", ".join(left_out)
+            if not passes.splits_light(settings):
+                message += " (the %s view has no light passes)" % settings.integrator
             print("Tesela: " + message)
             self.report({"WARNING"}, "Tesela: " + message)
 

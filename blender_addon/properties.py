@@ -29,6 +29,10 @@ class TeselaSceneSettings(bpy.types.PropertyGroup):
         description="Use a different seed for each frame (the seed plus the frame number)")
     threads: IntProperty(name="Threads", default=0, min=0, max=1024,
                          description="Render threads (0: all cores)")
+    tile_size: IntProperty(
+        name="Tile Size", default=32, min=8, max=4096, subtype="PIXEL",
+        description="Edge of the square tiles the image is rendered and shown in (smaller tiles "
+                    "appear sooner and balance threads better; larger ones cost less overhead)")
     diffuse_bounces: IntProperty(
         name="Diffuse", default=4, min=0, max=1024,
         description="Maximum number of diffuse reflection bounces, bounded by Max Depth")
@@ -57,6 +61,17 @@ class TeselaSceneSettings(bpy.types.PropertyGroup):
     adaptive_min_samples: IntProperty(
         name="Min Samples", default=0, min=0, max=4096,
         description="Samples every pixel takes before it may stop (0: automatic)")
+    preview_samples: IntProperty(
+        name="Viewport Samples", default=1024, min=0, max=1 << 24, soft_min=1,
+        description="Number of samples to render in the viewport, unlimited if 0")
+    preview_start_resolution: IntProperty(
+        name="Start Pixels", default=64, min=0, max=16384, subtype="PIXEL",
+        description="Resolution to start rendering the viewport at (its pixel count is about "
+                    "this squared), refined up to the full resolution; 0 starts at the pixel size")
+    use_preview_denoising: BoolProperty(
+        name="Viewport Denoise", default=False,
+        description="Denoise the image in the 3D viewport with Intel Open Image Denoise (when "
+                    "the renderer finds the library)")
     time_limit: FloatProperty(
         name="Time Limit", default=0.0, min=0.0, subtype="TIME_ABSOLUTE",
         description="Stop rendering after this many seconds (0: no limit)")

@@ -2,7 +2,8 @@
 # Runs every test of the project on a fresh machine, installing what the tests need:
 #   - Debian's Blender 3.4 (+ python3-numpy, Xvfb for its GUI) and the Khronos glTF validator (npm),
 #   - a virtual environment .venv with PyPI's bpy (Blender 5.x as a Python module), numpy, pytest,
-#     OpenEXR (reads the multi-layer EXRs of the pass tests),
+#     OpenEXR (reads the multi-layer EXRs of the pass tests), dask distributed and tesela-farm
+#     (farm/, editable: the render-farm tests),
 #     and pyoidn (its Open Image Denoise library, which the renderer loads at run time),
 # then: cargo fmt --check, cargo clippy -D warnings, cargo test, and pytest tests/blender.
 # Set TESELA_SKIP_INSTALL=1 to skip the installation steps.
@@ -26,6 +27,10 @@ if [[ "${TESELA_SKIP_INSTALL:-0}" != 1 ]]; then
     fi
     if ! .venv/bin/python -c 'import bpy, numpy, pytest, OpenEXR' 2>/dev/null; then
         .venv/bin/pip install -q --disable-pip-version-check bpy numpy pytest OpenEXR
+    fi
+    if ! .venv/bin/python -c 'import distributed, tesela_farm' 2>/dev/null; then
+        log "installing dask distributed and tesela-farm (farm/) into .venv"
+        .venv/bin/pip install -q --disable-pip-version-check dask distributed -e farm
     fi
     if ! .venv/bin/python -c 'import importlib.metadata as m; m.version("pyoidn")' 2>/dev/null; then
         log "installing pyoidn (Open Image Denoise) into .venv"

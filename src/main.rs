@@ -60,6 +60,9 @@ enum Command {
         #[arg(long, value_name = "PATH")]
         oidn_lib: Option<PathBuf>,
     },
+    /// Merge the accumulators of sample-range parts (`render --sample-range A:B
+    /// --accumulators PART.exr`) into the image of the whole render.
+    Merge(MergeArgs),
     /// Write a built-in scene as a .gltf file (how scenes/*.gltf are made).
     ExportBuiltin {
         /// One of: cornell-box, cornell-spheres, glass-pane.
@@ -136,8 +139,12 @@ struct RenderArgs {
     #[arg(long, value_name = "DEG", requires = "env", allow_hyphen_values = true)]
     env_rotation: Option<f32>,
     /// Auxiliary passes, comma-separated: depth, mist, normal, position, uv, object_index,
-    /// material_index, emission, environment, denoising_normal, denoising_albedo (Cycles'
-    /// passes of those names). An .exr output becomes multi-layer with Blender's layer and
+    /// material_index, emission, environment, denoising_normal, denoising_albedo,
+    /// diffuse_direct, diffuse_indirect, diffuse_color, glossy_direct, glossy_indirect,
+    /// glossy_color, transmission_direct, transmission_indirect, transmission_color (direct
+    /// and indirect divided by colour, as Cycles shows them; not with the normals and albedo
+    /// views), noisy_image (Combined before --denoise) (Cycles' passes of those names).
+    /// An .exr output becomes multi-layer with Blender's layer and
     /// channel names (ViewLayer.Depth.Z, ...); with --pipe they travel in the tiles
     /// (protocol version 2).
     #[arg(long, value_delimiter = ',', value_name = "LIST")]
@@ -198,6 +205,56 @@ struct RenderArgs {
     /// A constant world of linear RGB radiance R G B, replacing the scene's world.
     #[arg(long, num_args = 3, value_names = ["R", "G", "B"])]
     background: Option<Vec<f32>>,
+    /// Render only samples [A, B) of every pixel (of the --spp of the whole render), with the
+    /// random streams the whole render gives them, so parts rendered on several machines
+    /// merge exactly (`tesela merge`). Not with adaptive sampling, a time limit or --denoise.
+    #[arg(long, value_name = "A:B", value_parser = parse_sample_range, conflicts_with = "pipe")]
+    sample_range: Option<std::ops::Range<u32>>,
+    /// Write the film's unnormalised sums (radiance, coverage, sample counts, raw pass
+    /// records) to this OpenEXR file for `tesela merge` (docs/farm.md describes it). An
+    /// image is then written only if --output is given.
+    #[arg(long, value_name = "FILE", conflicts_with = "pipe")]
+    accumulators: Option<PathBuf>,
+}
+
+/// `A:B` with `A < B`: a range of sample indices.
+fn parse_sample_range(s: &str) -> Result<std::ops::Range<u32>, String> {
+    let bad = || format!("`{s}` is not a sample range A:B (0 <= A < B, e.g. 0:64)");
+    let (a, b) = s.split_once(':').ok_or_else(bad)?;
+    let (a, b): (u32, u32) = (
+        a.trim().parse().map_err(|_| bad())?,
+        b.trim().parse().map_err(|_| bad())?,
+    );
+    if a >= b {
+        return Err(bad());
+    }
+    Ok(a..b)
+}
+
+#[derive(clap::Args)]
+struct MergeArgs {
+    /// Accumulator files of one render (any order); their sample ranges must cover [0, spp).
+    #[arg(required = true)]
+    parts: Vec<PathBuf>,
+    /// Output image: .exr (multi-layer with the parts' passes) or .png.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Passes to write, comma-separated (default: every pass the parts hold).
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    passes: Option<Vec<String>>,
+    /// Denoise the merged image with Open Image Denoise (guided by the parts'
+    /// denoising_albedo and denoising_normal passes, if they have them).
+    #[arg(long)]
+    denoise: bool,
+    /// As `render --denoise-prefilter`.
+    #[arg(long, default_value = "accurate", value_parser = ["accurate", "fast", "none"])]
+    denoise_prefilter: String,
+    /// As `render --oidn-lib`.
+    #[arg(long, value_name = "PATH")]
+    oidn_lib: Option<PathBuf>,
+    /// No summary.
+    #[arg(short, long)]
+    quiet: bool,
 }
 
 #[derive(clap::Args)]
@@ -377,7 +434,9 @@ fn spawn_cancel_watchdog() {
             std::thread::sleep(Duration::from_millis(10));
         }
         std::thread::sleep(Duration::from_millis(250));
-        eprintln!("tesela: CANCELLED");
+        // Not eprintln!: it panics when stderr's reader is gone (a killed Blender), and this
+        // thread must reach the exit.
+        let _ = writeln!(std::io::stderr(), "tesela: CANCELLED");
         std::process::exit(EXIT_CANCELLED as i32);
     });
 }
@@ -748,7 +807,7 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(RenderError::Cancelled) => {
-            eprintln!("tesela: CANCELLED");
+            let _ = writeln!(std::io::stderr(), "tesela: CANCELLED");
             ExitCode::from(EXIT_CANCELLED)
         }
         Err(e) => {
@@ -776,7 +835,10 @@ fn light_choice(args: &RenderArgs) -> LightChoice {
 }
 
 fn run_render(args: &RenderArgs) -> ExitCode {
-    if let Err(e) = check_world_args(args).and_then(|_| check_film_args(args)) {
+    if let Err(e) = check_world_args(args)
+        .and_then(|_| check_film_args(args))
+        .and_then(|_| check_split_args(args))
+    {
         eprintln!("tesela: error: {e}");
         return ExitCode::from(EXIT_USAGE);
     }
@@ -792,18 +854,47 @@ fn run_render(args: &RenderArgs) -> ExitCode {
         eprintln!("tesela: error: {e}");
         return ExitCode::from(EXIT_RENDER);
     }
+    let split = split_range(args, &opts);
+    if let Some(r) = &split {
+        let why = render::unsplittable(&opts).map(|w| format!("{w} cannot be split exactly"));
+        if let Some(e) = why.or_else(|| {
+            (r.end > opts.spp).then(|| {
+                format!(
+                    "sample range {}:{} is outside the render's {} samples",
+                    r.start, r.end, opts.spp
+                )
+            })
+        }) {
+            eprintln!("tesela: error: --sample-range/--accumulators: {e}");
+            return ExitCode::from(EXIT_USAGE);
+        }
+    }
     let (denoiser, denoise_warning) = setup_denoiser(args, &mut opts);
     if let Some(w) = &denoise_warning {
         eprintln!("tesela: warning: {w}");
     }
-    let output = args
-        .output
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("tesela.png"));
-    if let Err(e) = check_output(&output) {
-        eprintln!("tesela: error: {e}");
-        return ExitCode::from(EXIT_RENDER);
+    // With --accumulators the sums are the result: an image only if asked for.
+    let output = match (&args.output, &args.accumulators) {
+        (Some(o), _) => Some(o.clone()),
+        (None, None) => Some(PathBuf::from("tesela.png")),
+        (None, Some(_)) => None,
+    };
+    for path in output.iter().chain(&args.accumulators) {
+        if let Err(e) = check_output(path) {
+            eprintln!("tesela: error: {e}");
+            return ExitCode::from(EXIT_RENDER);
+        }
     }
+    if let Some(a) = &args.accumulators
+        && !a.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    {
+        eprintln!(
+            "tesela: error: {}: accumulators are written as OpenEXR (use a .exr file name)",
+            a.display()
+        );
+        return ExitCode::from(EXIT_USAGE);
+    }
+    let key = split.as_ref().map(|_| render_key(args, &opts));
     let build = std::time::Instant::now();
     let rscene = prepare(scene, light_choice(args), opts.threads);
     for w in &rscene.scene.warnings {
@@ -832,27 +923,53 @@ fn run_render(args: &RenderArgs) -> ExitCode {
         bar.set_length(total as u64);
         bar.set_position(done as u64);
     };
-    let result = render::render(&rscene, &opts, &CANCEL, &on_tile);
+    let result = match &split {
+        None => render::render(&rscene, &opts, &CANCEL, &on_tile).map(|(i, s)| (i, s, None)),
+        Some(r) => render::render_range(&rscene, &opts, r.clone(), &CANCEL, &on_tile).map(
+            |(mut film, s)| {
+                film.key = key.clone().unwrap_or_default();
+                let mut image = film.resolve();
+                // The film also summed the Color passes its light passes are divided by.
+                image.retain_passes(&opts.passes);
+                (image, s, Some(film))
+            },
+        ),
+    };
     bar.finish_and_clear();
     match result {
-        Ok((mut image, stats)) => {
+        Ok((mut image, stats, film)) => {
             match finish_denoise(args, &mut image, denoiser.as_ref()) {
                 Some(Ok(m)) if !args.quiet => eprintln!("tesela: {m}"),
                 Some(Err(m)) => eprintln!("tesela: warning: {m}"),
                 _ => {}
             }
-            if let Err(e) = tesela::output::write(&image, &output) {
+            if let (Some(film), Some(path)) = (&film, &args.accumulators)
+                && let Err(e) = tesela::film::accumulators::write(film, path)
+            {
                 eprintln!("tesela: error: {e}");
                 return ExitCode::from(EXIT_RENDER);
             }
+            if let Some(output) = &output
+                && let Err(e) = tesela::output::write(&image, output)
+            {
+                eprintln!("tesela: error: {e}");
+                return ExitCode::from(EXIT_RENDER);
+            }
+            let output = output
+                .as_ref()
+                .or(args.accumulators.as_ref())
+                .map_or(String::new(), |p| p.display().to_string());
             if !args.quiet {
                 eprintln!(
                     "tesela: {}x{} {} spp {} -> {} in {:.2} s (+{:.2} s BVH): {:.2} M samples/s, {:.2} M rays/s, {} triangles{}",
                     image.width,
                     image.height,
-                    opts.spp,
+                    split.as_ref().map_or(opts.spp.to_string(), |r| format!(
+                        "samples {}:{} of {}",
+                        r.start, r.end, opts.spp
+                    )),
                     opts.integrator,
-                    output.display(),
+                    output,
                     stats.seconds,
                     build_s,
                     stats.samples_per_second / 1e6,
@@ -1009,6 +1126,7 @@ fn main() -> ExitCode {
         Command::Info { scene } => run_info(&scene),
         Command::Session { .. } => ExitCode::SUCCESS,
         Command::Study(args) => run_study(&args),
+        Command::Merge(args) => run_merge(&args),
         Command::ExportBuiltin { name, out } => match scene::builtin::by_name(&name) {
             Some(s) => match scene::gltf_write::write(&s, &out) {
                 Ok(()) => ExitCode::SUCCESS,
@@ -1023,4 +1141,131 @@ fn main() -> ExitCode {
             }
         },
     }
+}
+
+/// The sample range a split render renders: `--sample-range`, or all samples when only
+/// `--accumulators` is given; `None` for an ordinary render.
+fn split_range(args: &RenderArgs, opts: &RenderOptions) -> Option<std::ops::Range<u32>> {
+    match (&args.sample_range, &args.accumulators) {
+        (Some(r), _) => Some(r.clone()),
+        (None, Some(_)) => Some(0..opts.spp),
+        (None, None) => None,
+    }
+}
+
+/// Refuses the options a sample-range part cannot have before the scene is loaded.
+fn check_split_args(args: &RenderArgs) -> Result<(), String> {
+    if (args.sample_range.is_some() || args.accumulators.is_some()) && args.denoise {
+        return Err(
+            "--denoise on a sample-range part would denoise a noisier image than the \
+             whole render's (and denoised images do not add up): render the parts without \
+             it and denoise after merging (`tesela merge --denoise`)"
+                .into(),
+        );
+    }
+    Ok(())
+}
+
+/// FNV-1a, 64 bits: a stable fingerprint (the same on every machine and build).
+fn fnv1a(bytes: &[u8], mut h: u64) -> u64 {
+    for b in bytes {
+        h ^= *b as u64;
+        h = h.wrapping_mul(0x100_0000_01b3);
+    }
+    h
+}
+
+/// Names the render a part belongs to: the scene's bytes, the world options and every
+/// render option but the sample range, thread count and tile size, hashed. Parts with
+/// different keys do not merge.
+fn render_key(args: &RenderArgs, opts: &RenderOptions) -> String {
+    let scene = match (&args.builtin, &args.scene) {
+        (Some(b), _) => fnv1a(b.as_bytes(), 0xcbf2_9ce4_8422_2325),
+        (None, Some(p)) => fnv1a(&std::fs::read(p).unwrap_or_default(), 0xcbf2_9ce4_8422_2325),
+        (None, None) => 0,
+    };
+    let env = args
+        .env
+        .as_ref()
+        .map_or(0, |p| fnv1a(&std::fs::read(p).unwrap_or_default(), scene));
+    let mut o = opts.clone();
+    (o.threads, o.tile_size) = (0, 0);
+    let settings = format!(
+        "{o:?} {:?} {:?} {:?} {:?} {}",
+        args.env_strength, args.env_rotation, args.background, args.light_choice, env
+    );
+    format!(
+        "scene {scene:016x} options {:016x}",
+        fnv1a(settings.as_bytes(), 0xcbf2_9ce4_8422_2325)
+    )
+}
+
+/// `tesela merge`: adds the parts' sums, resolves, optionally denoises, writes the image.
+fn run_merge(args: &MergeArgs) -> ExitCode {
+    use tesela::film::accumulators;
+    if let Err(e) = check_output(&args.output) {
+        eprintln!("tesela: error: {e}");
+        return ExitCode::from(EXIT_USAGE);
+    }
+    let keep = match &args.passes {
+        Some(list) => match tesela::film::PassSet::parse(list.iter().map(String::as_str)) {
+            Ok(p) => Some(p),
+            Err(e) => {
+                eprintln!("tesela: error: --passes: {e}");
+                return ExitCode::from(EXIT_USAGE);
+            }
+        },
+        None => None,
+    };
+    let mut parts = Vec::with_capacity(args.parts.len());
+    for p in &args.parts {
+        match accumulators::read(p) {
+            Ok(a) => parts.push((p.display().to_string(), a)),
+            Err(e) => {
+                eprintln!("tesela: error: {e}");
+                return ExitCode::from(EXIT_LOAD);
+            }
+        }
+    }
+    let film = match accumulators::Accumulators::merge(parts) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("tesela: error: cannot merge: {e}");
+            return ExitCode::from(EXIT_USAGE);
+        }
+    };
+    let mut image = film.resolve();
+    if args.denoise {
+        let done = tesela::denoise::Denoiser::load(args.oidn_lib.as_deref(), 0)
+            .map_err(|e| e.to_string())
+            .and_then(|d| {
+                image
+                    .denoise(&d, args.denoise_prefilter == "accurate")
+                    .map(|_| d.describe())
+                    .map_err(|e| e.to_string())
+            });
+        match done {
+            Ok(d) if !args.quiet => eprintln!("tesela: denoised with {d}"),
+            Ok(_) => {}
+            Err(e) => eprintln!("tesela: warning: {e}; the image is not denoised"),
+        }
+    }
+    if let Some(keep) = &keep {
+        image.retain_passes(keep);
+    }
+    if let Err(e) = tesela::output::write(&image, &args.output) {
+        eprintln!("tesela: error: {e}");
+        return ExitCode::from(EXIT_RENDER);
+    }
+    if !args.quiet {
+        eprintln!(
+            "tesela: merged {} parts ({}x{}, {} spp) -> {}",
+            args.parts.len(),
+            image.width,
+            image.height,
+            film.spp,
+            args.output.display()
+        );
+    }
+    ExitCode::SUCCESS
 }

@@ -3,13 +3,16 @@
 //! thread count. Non-finite samples are rejected (counted, never written to the film).
 
 use crate::camera::RayCamera;
+use crate::film::accumulators::Accumulators;
 use crate::film::data::{self, DataContext};
 use crate::film::{Adaptive, PassSet, PixelAcc};
+use crate::integrator::light_split::LightSplit;
 use crate::integrator::{self, Integrator};
 use crate::render_scene::{Ctx, RayQuery, RenderScene};
 use crate::sampler::SobolSampler;
 use glam::Vec2;
 use rayon::prelude::*;
+use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
@@ -263,11 +266,19 @@ pub fn validate(opts: &RenderOptions) -> Result<(), RenderError> {
             "samples per pixel must be at least 1".into(),
         ));
     }
-    if integrator::by_name(&opts.integrator, 1).is_none() {
+    let Some(chosen) = integrator::by_name(&opts.integrator, 1) else {
         return Err(RenderError::Invalid(format!(
             "unknown integrator `{}` (choose one of {})",
             opts.integrator,
             integrator::NAMES.join(", ")
+        )));
+    };
+    if opts.passes.has_light() && !chosen.splits_light() {
+        return Err(RenderError::Invalid(format!(
+            "the light passes (diffuse/glossy/transmission direct and indirect) need a \
+             shading integrator (path_mis, path_mats, direct_mis, direct_ems, direct_mats), \
+             not `{}`",
+            opts.integrator
         )));
     }
     if let Some(t) = opts.time_limit
@@ -321,6 +332,7 @@ fn render_samples(
     let transparent = scene.scene.settings.film_transparent;
     let lens = camera.has_lens();
     let adaptive = opts.adaptive.is_some();
+    let light = data.is_some_and(|d| d.passes.has_light());
     for s in acc.next..end {
         ctx.sampler = match sampling {
             Sampling::Sobol => SobolSampler::new(opts.seed, pixel_index, s as u64),
@@ -344,7 +356,12 @@ fn render_samples(
             continue;
         };
         ctx.camera_end = ray.tmax.is_finite().then(|| ray.o + ray.d * ray.tmax);
-        let l = integrator.li(scene, ctx, ray.o, ray.d);
+        let mut split = LightSplit::default();
+        let l = if light {
+            integrator.li_split(scene, ctx, ray.o, ray.d, &mut split)
+        } else {
+            integrator.li(scene, ctx, ray.o, ray.d)
+        };
         if l.is_finite() && l.min_element() >= 0.0 {
             acc.sum += l;
             acc.accepted += 1;
@@ -356,6 +373,9 @@ fn render_samples(
             }
             if let Some(data) = data {
                 data.add_sample(ctx, ray.o, ray.d, acc.accepted == 1, aov);
+                if light {
+                    data.add_light(&split, aov);
+                }
             }
         } else {
             *rejected += 1;
@@ -385,13 +405,11 @@ struct Prepared {
 /// Checks `opts` and sets up the integrator, the camera and the pixel window.
 fn prepare(scene: &RenderScene, opts: &RenderOptions) -> Result<Prepared, RenderError> {
     validate(opts)?;
+    let integrator =
+        integrator::by_name_with(&opts.integrator, opts.max_depth.max(1), opts.light_paths)
+            .ok_or_else(|| RenderError::Invalid("unknown integrator".into()))?;
     Ok(Prepared {
-        integrator: integrator::by_name_with(
-            &opts.integrator,
-            opts.max_depth.max(1),
-            opts.light_paths,
-        )
-        .ok_or_else(|| RenderError::Invalid("unknown integrator".into()))?,
+        integrator,
         camera: RayCamera::new(&scene.scene, opts.width, opts.height),
         region: opts.region.unwrap_or([0, 0, opts.width, opts.height]),
     })
@@ -447,13 +465,20 @@ struct TileState {
 
 impl TileState {
     /// The tile as it stands now.
-    fn snapshot(&self, passes: &PassSet, transparent: bool, spp: u32) -> Tile {
-        let stride = passes.stride();
-        let mut aovs = vec![0.0; self.aov.len()];
+    /// The tile as it stands now, with the passes of `passes` from the sums laid out by
+    /// `acc` (`passes` and what they are computed from).
+    fn snapshot(&self, passes: &PassSet, acc: &PassSet, transparent: bool, spp: u32) -> Tile {
+        let (stride, acc_stride) = (passes.stride(), acc.stride());
+        let mut aovs = vec![0.0; self.px.len() * stride];
+        let noisy = passes.offset(crate::film::Pass::NoisyImage);
         if stride > 0 {
             for (i, p) in self.px.iter().enumerate() {
-                let r = i * stride..(i + 1) * stride;
-                data::resolve(passes, &self.aov[r.clone()], p.accepted, &mut aovs[r]);
+                let out = &mut aovs[i * stride..(i + 1) * stride];
+                let sums = &self.aov[i * acc_stride..(i + 1) * acc_stride];
+                data::resolve(acc, sums, p.accepted, passes, out);
+                if let Some(at) = noisy {
+                    out[at..at + 4].copy_from_slice(&p.rgba(transparent));
+                }
             }
         }
         Tile {
@@ -480,7 +505,60 @@ pub fn render(
     render_sampled(scene, opts, Sampling::Sobol, cancel, on_tile)
 }
 
-/// A film whose per-pixel sums persist between sample rounds. [`render_sampled`] runs its
+/// [`render`] with the random numbers drawn as `sampling` says.
+pub fn render_sampled(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    sampling: Sampling,
+    cancel: &AtomicBool,
+    on_tile: &(dyn Fn(&Tile, usize, usize) + Sync),
+) -> Result<(Image, RenderStats), RenderError> {
+    let (film, stats) = render_film(scene, opts, sampling, 0..opts.spp, cancel, on_tile)?;
+    let mut image = film.resolve();
+    // The film also summed the Color passes its light passes are divided by.
+    image.retain_passes(&opts.passes);
+    Ok((image, stats))
+}
+
+/// Renders samples `samples` (`[start, end)`, within `[0, opts.spp)`) of every pixel with the
+/// streams a whole render gives them, and returns the film's sums: the parts of a render
+/// split by sample range merge into it exactly ([`Accumulators::merge`]). Adaptive sampling
+/// and a time limit decide which samples exist from the whole film, so a part cannot have
+/// them. The returned key is empty: the caller names the render.
+pub fn render_range(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    samples: Range<u32>,
+    cancel: &AtomicBool,
+    on_tile: &(dyn Fn(&Tile, usize, usize) + Sync),
+) -> Result<(Accumulators, RenderStats), RenderError> {
+    if samples.start >= samples.end || samples.end > opts.spp {
+        return Err(RenderError::Invalid(format!(
+            "sample range {}:{} is empty or outside the render's {} samples",
+            samples.start, samples.end, opts.spp
+        )));
+    }
+    if let Some(why) = unsplittable(opts) {
+        return Err(RenderError::Invalid(format!(
+            "{why} cannot be split into sample ranges exactly"
+        )));
+    }
+    render_film(scene, opts, Sampling::Sobol, samples, cancel, on_tile)
+}
+
+/// What in `opts` makes a render's samples depend on the whole film (so a sample range
+/// cannot be rendered alone).
+pub fn unsplittable(opts: &RenderOptions) -> Option<&'static str> {
+    if opts.adaptive.is_some() {
+        Some("adaptive sampling (each pixel's sample count depends on the whole film)")
+    } else if opts.time_limit.is_some_and(|t| t > 0.0) {
+        Some("a time limit (the sample count depends on the machine's speed)")
+    } else {
+        None
+    }
+}
+
+/// A film whose per-pixel sums persist between sample rounds. [`render_film`] runs its
 /// rounds through one; the interactive session adds rounds as it goes. A pixel sums its
 /// samples in sample order whatever the split into rounds, so the image at `N` samples is
 /// the same bits however the rounds (and the threads) divided the work.
@@ -488,7 +566,11 @@ pub struct Progressive {
     prepared: Prepared,
     opts: RenderOptions,
     sampling: Sampling,
+    /// The film's sums: the passes asked for and the Color passes their light passes need.
+    acc_passes: PassSet,
     tiles: Vec<TileState>,
+    /// The first sample of every pixel.
+    first: u32,
     rounds: u32,
     /// Blender's film_transparent: alpha is the coverage.
     transparent: bool,
@@ -501,10 +583,21 @@ impl Progressive {
         opts: &RenderOptions,
         sampling: Sampling,
     ) -> Result<Progressive, RenderError> {
+        Self::starting_at(scene, opts, sampling, 0)
+    }
+
+    /// [`Progressive::new`] whose pixels start at sample `first`.
+    fn starting_at(
+        scene: &RenderScene,
+        opts: &RenderOptions,
+        sampling: Sampling,
+        first: u32,
+    ) -> Result<Progressive, RenderError> {
         let prepared = prepare(scene, opts)?;
         let [_, _, rw, rh] = prepared.region;
         let ts = opts.tile_size.max(1);
-        let stride = opts.passes.stride();
+        let acc_passes = opts.passes.with_dividers();
+        let acc_stride = acc_passes.stride();
         let mut tiles = Vec::new();
         for ty in (0..rh).step_by(ts as usize) {
             for tx in (0..rw).step_by(ts as usize) {
@@ -515,8 +608,14 @@ impl Progressive {
                     y: ty,
                     w: tw,
                     h: th,
-                    px: vec![PixelAcc::default(); n],
-                    aov: vec![0.0; n * stride],
+                    px: vec![
+                        PixelAcc {
+                            next: first,
+                            ..Default::default()
+                        };
+                        n
+                    ],
+                    aov: vec![0.0; n * acc_stride],
                     rays: 0,
                     rejected: 0,
                 });
@@ -526,7 +625,9 @@ impl Progressive {
             prepared,
             opts: opts.clone(),
             sampling,
+            acc_passes,
             tiles,
+            first,
             rounds: 0,
             transparent: scene.scene.settings.film_transparent,
         })
@@ -561,11 +662,11 @@ impl Progressive {
             region: [rx, ry, _, _],
         } = &self.prepared;
         let (opts, sampling) = (&self.opts, self.sampling);
-        let stride = opts.passes.stride();
-        let data_ctx = (!opts.passes.is_empty()).then_some(DataContext {
+        let acc_stride = self.acc_passes.stride();
+        let data_ctx = (!self.acc_passes.is_empty()).then_some(DataContext {
             scene,
             camera,
-            passes: &opts.passes,
+            passes: &self.acc_passes,
             mist: scene.scene.settings.mist,
         });
         let result: Result<(), RenderError> = pool.install(|| {
@@ -599,7 +700,7 @@ impl Progressive {
                             &mut ctx,
                             &mut rej,
                             acc,
-                            &mut t.aov[i * stride..(i + 1) * stride],
+                            &mut t.aov[i * acc_stride..(i + 1) * acc_stride],
                             sampling,
                         );
                     }
@@ -623,30 +724,37 @@ impl Progressive {
             .unwrap_or(0)
     }
 
-    /// The film as it stands: the window's pixels and passes.
-    pub fn image(&self) -> Image {
+    /// The film's sums as they stand, for samples `first..end` of a render of `spp`.
+    fn accumulators(&self, end: u32) -> Accumulators {
         let [_, _, rw, rh] = self.prepared.region;
-        let opts = &self.opts;
-        let stride = opts.passes.stride();
-        let transparent_film = self.transparent;
-        let mut image = Image {
+        let acc_stride = self.acc_passes.stride();
+        let mut film = Accumulators {
             width: rw,
             height: rh,
-            pixels: vec![[0.0; 4]; rw as usize * rh as usize],
-            passes: opts.passes.clone(),
-            aovs: vec![0.0; rw as usize * rh as usize * stride],
+            samples: self.first..end,
+            spp: self.opts.spp,
+            passes: self.acc_passes.clone(),
+            transparent: self.transparent,
+            key: String::new(),
+            pixels: vec![PixelAcc::default(); rw as usize * rh as usize],
+            aovs: vec![0.0; rw as usize * rh as usize * acc_stride],
         };
         for t in &self.tiles {
-            let snap = t.snapshot(&opts.passes, transparent_film, 0);
             for y in 0..t.h {
-                let src = &snap.pixels[(y * t.w) as usize..((y + 1) * t.w) as usize];
+                let src = (y * t.w) as usize..((y + 1) * t.w) as usize;
                 let row = (t.y + y) as usize * rw as usize + t.x as usize;
-                image.pixels[row..row + t.w as usize].copy_from_slice(src);
-                let a = (y * t.w) as usize * stride..((y + 1) * t.w) as usize * stride;
-                image.aovs[row * stride..(row + t.w as usize) * stride]
-                    .copy_from_slice(&snap.aovs[a]);
+                film.pixels[row..row + t.w as usize].copy_from_slice(&t.px[src.clone()]);
+                film.aovs[row * acc_stride..(row + t.w as usize) * acc_stride]
+                    .copy_from_slice(&t.aov[src.start * acc_stride..src.end * acc_stride]);
             }
         }
+        film
+    }
+
+    /// The film as it stands: the window's pixels and the passes asked for.
+    pub fn image(&self) -> Image {
+        let mut image = self.accumulators(self.samples()).resolve();
+        image.retain_passes(&self.opts.passes);
         image
     }
 
@@ -657,9 +765,10 @@ impl Progressive {
         let (mut spp_min, mut spp_max, mut noise) = (u32::MAX, 0u32, 0.0f64);
         for t in &self.tiles {
             for p in &t.px {
-                samples += p.next as u64;
-                spp_min = spp_min.min(p.next);
-                spp_max = spp_max.max(p.next);
+                let n = p.next - self.first;
+                samples += n as u64;
+                spp_min = spp_min.min(n);
+                spp_max = spp_max.max(n);
                 let e = p.error() as f64;
                 if e.is_finite() {
                     noise += e;
@@ -686,19 +795,27 @@ impl Progressive {
     }
 }
 
-/// [`render`] with the random numbers drawn as `sampling` says.
-pub fn render_sampled(
+/// Renders samples `range` of every pixel into the film's sums (rounds, adaptive sampling
+/// and the time limit only for a whole render, `0..opts.spp`).
+fn render_film(
     scene: &RenderScene,
     opts: &RenderOptions,
     sampling: Sampling,
+    range: Range<u32>,
     cancel: &AtomicBool,
     on_tile: &(dyn Fn(&Tile, usize, usize) + Sync),
-) -> Result<(Image, RenderStats), RenderError> {
-    let mut film = Progressive::new(scene, opts, sampling)?;
+) -> Result<(Accumulators, RenderStats), RenderError> {
+    let mut film = Progressive::starting_at(scene, opts, sampling, range.start)?;
     let [_, _, rw, rh] = film.prepared.region;
+    let acc_passes = film.acc_passes.clone();
     let transparent = film.transparent;
     let time_limit = opts.time_limit.filter(|t| *t > 0.0);
-    let ends = crate::film::round_ends(opts.spp, opts.adaptive.as_ref(), time_limit.is_some());
+    let whole = range == (0..opts.spp);
+    let ends = if whole {
+        crate::film::round_ends(opts.spp, opts.adaptive.as_ref(), time_limit.is_some())
+    } else {
+        vec![range.end]
+    };
     let threshold = opts.adaptive.map(|a| a.resolved(opts.spp).0);
     let total = film.tiles.len() * ends.len();
     let done = AtomicUsize::new(0);
@@ -716,7 +833,11 @@ pub fn render_sampled(
         let after = |t: &TileState, worked: bool| {
             let n = done.fetch_add(1, Ordering::Relaxed) + 1;
             if stream && (worked || last) {
-                on_tile(&t.snapshot(&opts.passes, transparent, end), n, total);
+                on_tile(
+                    &t.snapshot(&opts.passes, &acc_passes, transparent, end),
+                    n,
+                    total,
+                );
             }
         };
         film.round_with(scene, end, &pool, cancel, &after)?;
@@ -742,14 +863,14 @@ pub fn render_sampled(
         for (i, t) in film.tiles.iter().enumerate() {
             let spp = t.px.iter().map(|p| p.next).max().unwrap_or(0);
             on_tile(
-                &t.snapshot(&opts.passes, transparent, spp),
+                &t.snapshot(&opts.passes, &acc_passes, transparent, spp),
                 total - n + i + 1,
                 total,
             );
         }
     }
-    let image = film.image();
-    Ok((image, film.stats(start.elapsed().as_secs_f64())))
+    let stats = film.stats(start.elapsed().as_secs_f64());
+    Ok((film.accumulators(range.end), stats))
 }
 
 /// Adaptive sampling's check after a round: marks the pixels whose error is below

@@ -977,6 +977,7 @@ impl RenderScene {
         ShaderGlobals {
             p: to_blender(its.p),
             n: to_blender(n),
+            n_displaced: false,
             ng: to_blender(ng),
             i: to_blender(-d),
             backfacing,

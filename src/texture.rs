@@ -115,6 +115,39 @@ pub fn filter(
     top.lerp(bottom, fy)
 }
 
+/// Cycles' cubic interpolation: a uniform cubic B-spline over the 4 × 4 texels around `uv`
+/// (glTF convention, as [`filter`]), texel centres at half-integers; `fetch` wraps or clips.
+/// Its weights are positive, so the result stays within the texels' range.
+pub fn filter_cubic(width: u32, height: u32, uv: Vec2, fetch: impl Fn(i64, i64) -> Vec4) -> Vec4 {
+    let x = (uv.x as f64 * width as f64 - 0.5).clamp(-1e9, 1e9);
+    let y = (uv.y as f64 * height as f64 - 0.5).clamp(-1e9, 1e9);
+    let (x0, y0) = (x.floor(), y.floor());
+    let (tx, ty) = ((x - x0) as f32, (y - y0) as f32);
+    let (x0, y0) = (x0 as i64, y0 as i64);
+    let (u, v) = (bspline_weights(tx), bspline_weights(ty));
+    let mut sum = Vec4::ZERO;
+    for (j, wy) in v.iter().enumerate() {
+        let mut row = Vec4::ZERO;
+        for (i, wx) in u.iter().enumerate() {
+            row += *wx * fetch(x0 + i as i64 - 1, y0 + j as i64 - 1);
+        }
+        sum += *wy * row;
+    }
+    sum
+}
+
+/// The uniform cubic B-spline's weights for the texels at offsets -1, 0, 1, 2 of a point a
+/// fraction `t` past texel 0 (they sum to 1).
+#[inline]
+fn bspline_weights(t: f32) -> [f32; 4] {
+    [
+        (((-1.0 / 6.0) * t + 0.5) * t - 0.5) * t + 1.0 / 6.0,
+        ((0.5 * t - 1.0) * t) * t + 2.0 / 3.0,
+        ((-0.5 * t + 0.5) * t + 0.5) * t + 1.0 / 6.0,
+        (1.0 / 6.0) * t * t * t,
+    ]
+}
+
 /// Looks up `tex` (whose image is `img`) at `uv`. `srgb` decodes colour data to linear.
 pub fn lookup(tex: &Texture, img: &Image, uv: Vec2, srgb: bool) -> Vec4 {
     if img.width == 0 || img.height == 0 || !uv.is_finite() {
@@ -191,5 +224,31 @@ mod tests {
         // Filtering happens before decoding: halfway between red and green is sRGB 0.5.
         let mid = lookup(&tex, &img, Vec2::new(0.5, 0.25), true);
         assert!((mid.x - srgb_to_linear(0.5)).abs() < 1e-6, "{mid}");
+    }
+
+    #[test]
+    fn cubic_is_the_uniform_bspline() {
+        // A single bright texel in an 8 x 8 image (repeating): at its centre the B-spline gives
+        // 2/3 of it, half a texel off 23/48, a texel off 1/6 (the linear filter: 1, 1/2, 0).
+        let spike = |x: i64, y: i64| {
+            let (x, y) = (x.rem_euclid(8), y.rem_euclid(8));
+            if (x, y) == (3, 4) {
+                Vec4::ONE
+            } else {
+                Vec4::ZERO
+            }
+        };
+        let at = |tx: f32, ty: f32| filter_cubic(8, 8, Vec2::new(tx / 8.0, ty / 8.0), spike).x;
+        assert!((at(3.5, 4.5) - 4.0 / 9.0).abs() < 1e-6, "{}", at(3.5, 4.5));
+        assert!((at(4.0, 4.5) - 2.0 / 3.0 * 23.0 / 48.0).abs() < 1e-6);
+        assert!((at(4.5, 4.5) - 2.0 / 3.0 / 6.0).abs() < 1e-6);
+        // A linear ramp is reproduced exactly, and the weights sum to one.
+        let ramp = |x: i64, _y: i64| Vec4::splat(x as f32);
+        for x in [2.5f32, 3.1, 4.75, 5.5] {
+            let v = filter_cubic(16, 16, Vec2::new(x / 16.0, 0.5), ramp).x;
+            assert!((v - (x - 0.5)).abs() < 1e-4, "{x}: {v}");
+        }
+        let ones = filter_cubic(8, 8, Vec2::new(0.37, 0.61), |_, _| Vec4::ONE);
+        assert!((ones - Vec4::ONE).length() < 1e-6);
     }
 }

@@ -294,3 +294,29 @@ fn denoising_is_deterministic_across_thread_counts() {
         one.describe()
     );
 }
+
+#[test]
+fn noisy_image_keeps_combined_from_before_denoising() {
+    let Some(d) = denoiser(0) else { return };
+    use tesela::film::{Pass, PassSet};
+    let opts = RenderOptions {
+        width: 32,
+        height: 32,
+        spp: 8,
+        max_depth: 6,
+        passes: PassSet::new([
+            Pass::NoisyImage,
+            Pass::DenoisingAlbedo,
+            Pass::DenoisingNormal,
+        ]),
+        ..Default::default()
+    };
+    let rs = RenderScene::new(tesela::scene::builtin::cornell_box(), LightChoice::Power);
+    let (mut img, _) = render::render(&rs, &opts, &AtomicBool::new(false), &|_, _, _| {}).unwrap();
+    let before: Vec<f32> = img.pixels.iter().flatten().copied().collect();
+    assert!(img.pass(Pass::NoisyImage).unwrap() == before);
+    img.denoise(&d, true).unwrap();
+    let after: Vec<f32> = img.pixels.iter().flatten().copied().collect();
+    assert!(after != before, "the denoiser changed nothing");
+    assert!(img.pass(Pass::NoisyImage).unwrap() == before);
+}

@@ -5,6 +5,7 @@ use super::sheen::Sheen;
 use super::{
     BaseLobe, BsdfInstance, Coat, DELTA_ALPHA, Dielectric, Diffuse, Layered, Mirror, Plastic,
     RoughConductor, RoughDielectric, SurfaceParams, TopLobe, Translucent, Transparent, choose,
+    principled_specular_ior,
 };
 use crate::shading::{Closure, ClosureKind, Principled};
 use glam::Vec3;
@@ -143,13 +144,22 @@ fn principled(p: &Principled, u: f32) -> BsdfInstance {
             }
         } else if p.specular_level * p.specular_tint.max_element() <= 0.0 {
             BaseLobe::Diffuse(Diffuse::new(p.base_color))
-        } else {
+        } else if ax.max(ay) < DELTA_ALPHA {
             BaseLobe::Plastic(Plastic::new(
                 p.base_color,
                 alpha,
                 p.ior,
                 2.0 * p.specular_level,
                 p.specular_tint,
+            ))
+        } else {
+            // Cycles: a GGX reflection with the Fresnel of the level-adjusted IOR over the
+            // diffuse base, which keeps what the specular layer's albedo leaves.
+            let ior = principled_specular_ior(p.ior, p.specular_level);
+            let specular = RoughDielectric::principled_specular(p.specular_tint, ior, ax, ay);
+            BaseLobe::SpecularDiffuse(Layered::new(
+                specular.multiscatter(),
+                Diffuse::new(p.base_color),
             ))
         }
     };
@@ -185,6 +195,10 @@ fn unlayered(b: BaseLobe) -> BsdfInstance {
         BaseLobe::Plastic(x) => BsdfInstance::Plastic(x),
         BaseLobe::RoughDielectric(x) => BsdfInstance::RoughDielectric(x),
         BaseLobe::Translucent(x) => BsdfInstance::Translucent(x),
+        BaseLobe::SpecularDiffuse(l) => BsdfInstance::Layered(Layered::new(
+            TopLobe::Specular(l.top),
+            BaseLobe::Diffuse(l.base),
+        )),
         other => BsdfInstance::Layered(Layered::new(
             TopLobe::Sheen(Sheen::new(Vec3::ZERO, 0.5)),
             other,

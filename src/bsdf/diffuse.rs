@@ -5,7 +5,9 @@ use crate::sampling::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_p
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 
-/// A Lambertian reflector of the given albedo (reflects on the `+Z` side only).
+/// A Lambertian reflector of the given albedo (reflects on the `+Z` side only, whichever side
+/// the light comes from: as Cycles' diffuse closure, a mapped normal turned away from the
+/// viewer still shades with its own cosine).
 #[derive(Clone, Copy, Debug)]
 pub struct Diffuse {
     pub albedo: Vec3,
@@ -19,9 +21,6 @@ impl Diffuse {
 
 impl Bsdf for Diffuse {
     fn sample(&self, rec: &mut BsdfQueryRecord, u: Vec2, _u1: f32) -> Vec3 {
-        if rec.wi.z <= 0.0 {
-            return Vec3::ZERO;
-        }
         rec.wo = square_to_cosine_hemisphere(u);
         rec.eta = 1.0;
         rec.measure = Measure::SolidAngle;
@@ -34,20 +33,22 @@ impl Bsdf for Diffuse {
     }
 
     fn eval(&self, rec: &BsdfQueryRecord) -> Vec3 {
-        if rec.wi.z <= 0.0 || rec.wo.z <= 0.0 {
+        if rec.wo.z <= 0.0 {
             return Vec3::ZERO;
         }
         self.albedo * FRAC_1_PI
     }
 
     fn pdf(&self, rec: &BsdfQueryRecord) -> f32 {
-        if rec.wi.z <= 0.0 {
-            return 0.0;
-        }
         square_to_cosine_hemisphere_pdf(rec.wo)
     }
 
     fn is_delta(&self) -> bool {
         false
+    }
+
+    /// Cycles counts this lobe among the diffuse closures.
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        [self.eval(rec), Vec3::ZERO]
     }
 }

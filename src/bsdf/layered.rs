@@ -33,6 +33,12 @@ pub trait Layer: Bsdf {
     fn albedo(&self, wi: Vec3) -> Vec3;
     /// The factor `A(wi)` applied to everything below.
     fn attenuation(&self, wi: Vec3) -> Vec3;
+    /// Precomputes what depends on the incident direction `wi` alone (nothing by default).
+    fn prepare(&mut self, _wi: Vec3) {}
+    /// `(albedo(wi), attenuation(wi))` together (a layer may share the work).
+    fn albedo_attenuation(&self, wi: Vec3) -> (Vec3, Vec3) {
+        (self.albedo(wi), self.attenuation(wi))
+    }
 }
 
 /// The Principled BSDF's coat: a GGX reflection with the dielectric Fresnel of the coat IOR
@@ -119,6 +125,10 @@ impl Layer for Coat {
 /// `factor · E(μ)` folded into the closure weight. The layers below are scaled by
 /// `1 - max(albedo)`.
 impl Layer for RoughDielectric {
+    fn prepare(&mut self, wi: Vec3) {
+        RoughDielectric::prepare(self, wi);
+    }
+
     fn albedo(&self, wi: Vec3) -> Vec3 {
         if wi.z <= 0.0 || self.mode != super::DielectricMode::Reflection {
             return Vec3::ZERO;
@@ -143,10 +153,15 @@ impl Layer for RoughDielectric {
     }
 
     fn attenuation(&self, wi: Vec3) -> Vec3 {
+        self.albedo_attenuation(wi).1
+    }
+
+    fn albedo_attenuation(&self, wi: Vec3) -> (Vec3, Vec3) {
         if wi.z <= 0.0 {
-            return Vec3::ONE;
+            return (Layer::albedo(self, wi), Vec3::ONE);
         }
-        Vec3::splat((1.0 - Layer::albedo(self, wi).max_element()).clamp(0.0, 1.0))
+        let a = Layer::albedo(self, wi);
+        (a, Vec3::splat((1.0 - a.max_element()).clamp(0.0, 1.0)))
     }
 }
 
@@ -204,18 +219,55 @@ impl Layer for Sheen {
 pub struct Layered<T, B> {
     pub top: T,
     pub base: B,
+    /// `(wi, split(wi))` computed once for the shading point's incident direction: the top's
+    /// albedo estimate (table lookups) is the costly part of every query.
+    prepared: Option<(Vec3, f32, Vec3)>,
 }
 
 impl<T: Layer, B: Bsdf> Layered<T, B> {
     pub fn new(top: T, base: B) -> Self {
-        Layered { top, base }
+        Layered {
+            top,
+            base,
+            prepared: None,
+        }
+    }
+
+    /// Computes the layering for the incident direction `wi` that the queries will use (the
+    /// same values as without it, found once).
+    #[inline]
+    pub fn prepare(&mut self, wi: Vec3) {
+        self.top.prepare(wi);
+        self.prepared = None;
+        let (p, att) = self.split(wi);
+        self.prepared = Some((wi, p, att));
+    }
+
+    /// The probability with which `sample` picks the top lobe for `wi`.
+    #[inline]
+    pub fn top_probability(&self, wi: Vec3) -> f32 {
+        self.split(wi).0
+    }
+
+    /// `A(wi)`, the factor on everything below the top.
+    #[inline]
+    pub fn attenuation_at(&self, wi: Vec3) -> Vec3 {
+        match self.prepared {
+            Some((w, _, att)) if w == wi => att,
+            _ => self.top.attenuation(wi),
+        }
     }
 
     /// `(probability of sampling the top, A(wi))`.
     #[inline]
     fn split(&self, wi: Vec3) -> (f32, Vec3) {
-        let att = self.top.attenuation(wi);
-        let t = self.top.albedo(wi).element_sum().max(0.0);
+        if let Some((w, p, att)) = self.prepared
+            && w == wi
+        {
+            return (p, att);
+        }
+        let (albedo, att) = self.top.albedo_attenuation(wi);
+        let t = albedo.element_sum().max(0.0);
         let b = att.element_sum().max(0.0);
         let p = if t + b > 0.0 { t / (t + b) } else { 0.0 };
         (p, att)
@@ -269,8 +321,15 @@ impl<T: Layer, B: Bsdf> Bsdf for Layered<T, B> {
     }
 
     fn eval(&self, rec: &BsdfQueryRecord) -> Vec3 {
-        let att = self.top.attenuation(rec.wi);
+        let att = self.attenuation_at(rec.wi);
         self.top.eval(rec) + att * self.base.eval(rec)
+    }
+
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        let att = self.attenuation_at(rec.wi);
+        let [td, tg] = self.top.eval_split(rec);
+        let [bd, bg] = self.base.eval_split(rec);
+        [td + att * bd, tg + att * bg]
     }
 
     fn pdf(&self, rec: &BsdfQueryRecord) -> f32 {
@@ -357,6 +416,9 @@ impl Bsdf for TopLobe {
     fn is_delta(&self) -> bool {
         dispatch_top!(self, b => b.is_delta())
     }
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        dispatch_top!(self, b => b.eval_split(rec))
+    }
 }
 
 impl Layer for TopLobe {
@@ -365,6 +427,12 @@ impl Layer for TopLobe {
     }
     fn attenuation(&self, wi: Vec3) -> Vec3 {
         dispatch_top!(self, b => b.attenuation(wi))
+    }
+    fn prepare(&mut self, wi: Vec3) {
+        dispatch_top!(self, b => Layer::prepare(b, wi))
+    }
+    fn albedo_attenuation(&self, wi: Vec3) -> (Vec3, Vec3) {
+        dispatch_top!(self, b => b.albedo_attenuation(wi))
     }
 }
 
@@ -380,6 +448,9 @@ impl Bsdf for BaseLobe {
     }
     fn is_delta(&self) -> bool {
         dispatch_base!(self, b => b.is_delta())
+    }
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        dispatch_base!(self, b => b.eval_split(rec))
     }
 }
 

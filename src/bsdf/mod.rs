@@ -91,6 +91,13 @@ pub trait Bsdf {
     fn pdf(&self, rec: &BsdfQueryRecord) -> f32;
     /// True when every lobe is a Dirac delta (emitter sampling cannot contribute).
     fn is_delta(&self) -> bool;
+    /// The parts of `eval` that Cycles' light passes call diffuse and glossy, as
+    /// `[diffuse, glossy]` in the units of `eval`; what remains of `eval` is transmission
+    /// (Cycles' closure classes: translucent and sheen are diffuse, a glass lobe is glossy on
+    /// the side of `wi` and transmission across). By default the whole value is glossy.
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        [Vec3::ZERO, self.eval(rec)]
+    }
 }
 
 /// The BSDF chosen at one surface hit: a closed set of variants, built on the stack.
@@ -147,6 +154,10 @@ impl Bsdf for BsdfInstance {
     fn is_delta(&self) -> bool {
         dispatch!(self, b => b.is_delta())
     }
+    #[inline]
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        dispatch!(self, b => b.eval_split(rec))
+    }
 }
 
 impl BsdfInstance {
@@ -159,6 +170,21 @@ impl BsdfInstance {
             BsdfInstance::RoughDielectric(d) => d.mode != DielectricMode::Reflection,
             BsdfInstance::Layered(l) => l.base.is_transmissive(),
             _ => false,
+        }
+    }
+
+    /// A glossy layer over a diffuse base evaluated as its two parts, `(diffuse, glossy)` per
+    /// steradian (their sum is `eval`), for the corrections Cycles applies to its diffuse
+    /// closures alone; `None` for BSDFs that are not such a pair.
+    #[inline]
+    pub fn diffuse_parts(&self, rec: &BsdfQueryRecord) -> Option<(Vec3, Vec3)> {
+        match self {
+            BsdfInstance::Plastic(p) => Some(p.eval_parts(rec)),
+            BsdfInstance::Layered(l) if matches!(l.base, BaseLobe::Diffuse(_)) => {
+                let att = l.attenuation_at(rec.wi);
+                Some((att * l.base.eval(rec), l.top.eval(rec)))
+            }
+            _ => None,
         }
     }
 }

@@ -39,13 +39,33 @@ impl Plastic {
     }
 
     #[inline]
-    fn coat_share(&self, cos_i: f32) -> f32 {
+    pub(crate) fn coat_share(&self, cos_i: f32) -> f32 {
         self.specular * fresnel::schlick1(self.f0, cos_i)
     }
 
     #[inline]
     fn smooth(&self) -> bool {
         self.alpha < DELTA_ALPHA
+    }
+
+    /// The non-delta BSDF split into its Lambertian base and its glossy coat, `(base, coat)`,
+    /// per steradian (their sum is [`Bsdf::eval`]): Cycles shades the two as separate closures,
+    /// and a bumped normal darkens only the diffuse one.
+    #[inline]
+    pub fn eval_parts(&self, rec: &BsdfQueryRecord) -> (Vec3, Vec3) {
+        let (wi, wo) = (rec.wi, rec.wo);
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return (Vec3::ZERO, Vec3::ZERO);
+        }
+        let s = self.coat_share(wi.z);
+        let base = (1.0 - s) * self.base * FRAC_1_PI;
+        if self.smooth() {
+            return (base, Vec3::ZERO);
+        }
+        let h = (wi + wo).normalize();
+        let coat = s * self.coat_tint * ggx_d(h, self.alpha) * ggx_g2(wi, wo, self.alpha)
+            / (4.0 * wi.z * wo.z);
+        (base, coat)
     }
 }
 
@@ -85,18 +105,8 @@ impl Bsdf for Plastic {
     }
 
     fn eval(&self, rec: &BsdfQueryRecord) -> Vec3 {
-        let (wi, wo) = (rec.wi, rec.wo);
-        if wi.z <= 0.0 || wo.z <= 0.0 {
-            return Vec3::ZERO;
-        }
-        let s = self.coat_share(wi.z);
-        let mut f = (1.0 - s) * self.base * FRAC_1_PI;
-        if !self.smooth() {
-            let h = (wi + wo).normalize();
-            f += s * self.coat_tint * ggx_d(h, self.alpha) * ggx_g2(wi, wo, self.alpha)
-                / (4.0 * wi.z * wo.z);
-        }
-        f
+        let (base, coat) = self.eval_parts(rec);
+        base + coat
     }
 
     fn pdf(&self, rec: &BsdfQueryRecord) -> f32 {
@@ -114,5 +124,15 @@ impl Bsdf for Plastic {
 
     fn is_delta(&self) -> bool {
         false
+    }
+
+    /// The Lambertian base is diffuse, the coat glossy.
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        let f = self.eval(rec);
+        if f == Vec3::ZERO {
+            return [Vec3::ZERO; 2];
+        }
+        let diffuse = (1.0 - self.coat_share(rec.wi.z)) * self.base * FRAC_1_PI;
+        [diffuse, (f - diffuse).max(Vec3::ZERO)]
     }
 }

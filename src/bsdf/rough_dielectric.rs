@@ -58,6 +58,8 @@ pub struct RoughDielectric {
     pub transmission_tint: Vec3,
     /// `F_ss` of Cycles' energy compensation, when enabled ([`RoughDielectric::multiscatter`]).
     pub multiscatter_fss: Option<Vec3>,
+    /// `(cos θi, η, energy_factor)` found once for the shading point's incident direction.
+    energy_at: Option<(f32, f32, Vec3)>,
 }
 
 /// Relative index within this distance of 1 makes refraction a pass-through (Cycles treats it
@@ -89,6 +91,7 @@ impl RoughDielectric {
             reflection_tint: reflection_tint.max(Vec3::ZERO),
             transmission_tint: transmission_tint.max(Vec3::ZERO),
             multiscatter_fss: None,
+            energy_at: None,
         }
     }
 
@@ -127,12 +130,30 @@ impl RoughDielectric {
         let Some(fss) = self.multiscatter_fss else {
             return Vec3::ONE;
         };
+        if let Some((z, e, f)) = self.energy_at
+            && z == wi_z
+            && e == eta
+        {
+            return f;
+        }
         let a = &self.roughness;
         let (e, e_avg) = match self.mode {
             DielectricMode::Glass => tables::ggx_glass_e((a.alpha_x * a.alpha_y).sqrt(), wi_z, eta),
             _ => tables::ggx_e(a.alpha_x, a.alpha_y, wi_z),
         };
         tables::multiscatter_factor(e, e_avg, fss)
+    }
+
+    /// Computes the energy compensation for the incident direction `wi` the queries will use
+    /// (the same value, found once: it costs table lookups).
+    pub fn prepare(&mut self, wi: Vec3) {
+        if self.multiscatter_fss.is_none() || wi.z == 0.0 {
+            return;
+        }
+        self.energy_at = None;
+        let (flip, eta) = self.side(wi);
+        let z = mirror(wi, flip).z;
+        self.energy_at = Some((z, eta, self.energy_factor(z, eta)));
     }
 
     /// Blender's Glass BSDF (GGX): Color tints reflection and refraction alike (Cycles sets
@@ -397,6 +418,15 @@ impl Bsdf for RoughDielectric {
         let (flip, eta) = self.side(rec.wi);
         self.eval_pdf(mirror(rec.wi, flip), mirror(rec.wo, flip), eta)
             .0
+    }
+
+    /// Reflection is glossy, refraction transmission.
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        if rec.wi.z * rec.wo.z > 0.0 {
+            [Vec3::ZERO, self.eval(rec)]
+        } else {
+            [Vec3::ZERO; 2]
+        }
     }
 
     fn pdf(&self, rec: &BsdfQueryRecord) -> f32 {

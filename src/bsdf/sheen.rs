@@ -173,4 +173,9 @@ impl Bsdf for Sheen {
     fn is_delta(&self) -> bool {
         false
     }
+
+    /// Cycles counts this lobe among the diffuse closures.
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        [self.eval(rec), Vec3::ZERO]
+    }
 }

@@ -54,4 +54,9 @@ impl Bsdf for Translucent {
     fn is_delta(&self) -> bool {
         false
     }
+
+    /// Cycles counts this lobe among the diffuse closures.
+    fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
+        [self.eval(rec), Vec3::ZERO]
+    }
 }

@@ -7,10 +7,12 @@
 //! surface whose alpha reaches 1/2 (Cycles' alpha threshold), the light passes add up along
 //! the way, weighted by the transmittance in front.
 
-use super::pass::{Pass, PassSet};
+use super::color::closure_colors;
+use super::pass::{LightClass, Pass, PassSet};
 use crate::accel::offset_origin;
 use crate::camera::RayCamera;
 use crate::integrator::MAX_TRANSPARENT;
+use crate::integrator::light_split::LightSplit;
 use crate::render_scene::{Ctx, RenderScene};
 use crate::scene::Mist;
 use crate::shading::globals::{ray, to_blender};
@@ -66,6 +68,11 @@ impl DataContext<'_> {
         let mut emission = Vec3::ZERO;
         let mut mist = 0.0f32;
         let want_emission = set.contains(Pass::Emission);
+        // Cycles writes the Color passes at every surface the camera ray passes through
+        // until it first scatters, weighted by the transparency in front.
+        let want_colors = LightClass::ALL
+            .into_iter()
+            .any(|c| set.contains(c.passes().2));
         for _ in 0..=MAX_TRANSPARENT {
             let hit = scene.trace(ctx, p, d, 1);
             if want_emission {
@@ -109,12 +116,19 @@ impl DataContext<'_> {
             };
             let mut transparent = Vec3::ZERO;
             let (mut n_avg, mut n_feature, mut albedo) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+            let mut colors = [Vec3::ZERO; 3];
             for c in closures.closures() {
                 let n = if c.normal == Vec3::ZERO {
                     default_n
                 } else {
                     c.normal
                 };
+                if want_colors {
+                    let k = closure_colors(c, n.dot(-d), backfacing);
+                    for (a, b) in colors.iter_mut().zip(k) {
+                        *a += tr * b;
+                    }
+                }
                 match closure_albedo(c) {
                     None => transparent += c.weight,
                     Some(a) => {
@@ -122,6 +136,13 @@ impl DataContext<'_> {
                         n_avg += n * w;
                         n_feature += n * ((a.x + a.y + a.z) / 3.0);
                         albedo += a;
+                    }
+                }
+            }
+            if want_colors {
+                for (class, v) in LightClass::ALL.into_iter().zip(colors) {
+                    if let Some(at) = set.offset(class.passes().2) {
+                        put(acc, at, &v.to_array(), false);
                     }
                 }
             }
@@ -149,6 +170,19 @@ impl DataContext<'_> {
             acc[at] += mist;
         }
         (ctx.depth, ctx.ray_flags) = saved;
+    }
+
+    /// Adds one sample's light passes (radiance, divided by colour only when resolved).
+    pub fn add_light(&self, split: &LightSplit, acc: &mut [f32]) {
+        for class in LightClass::ALL {
+            let (direct, indirect, _) = class.passes();
+            let i = class as usize;
+            for (p, v) in [(direct, split.direct[i]), (indirect, split.indirect[i])] {
+                if let Some(at) = self.passes.offset(p) {
+                    put(acc, at, &v.to_array(), false);
+                }
+            }
+        }
     }
 
     /// The data passes of the first (opaque enough) surface.
@@ -190,22 +224,52 @@ impl DataContext<'_> {
                     false,
                 ),
                 Pass::DenoisingAlbedo => put(acc, at, &albedo.to_array(), false),
-                Pass::Mist | Pass::Emission | Pass::Environment => {}
+                _ => {}
             }
         }
     }
 }
 
-/// Turns a pixel's accumulated record into pass values: averages over `n` samples, and
-/// Blender's conventions for what was never written (Depth 1e10 where the camera saw no
-/// surface; Mist stored as `1 - value`).
-pub fn resolve(set: &PassSet, acc: &[f32], n: u32, out: &mut [f32]) {
+/// Cycles' `safe_divide_even_color`: `a / b` per channel, and where a channel of `b` is 0,
+/// the mean of the other channels' quotients (grey rather than black).
+pub fn divide_even_color(a: Vec3, b: Vec3) -> Vec3 {
+    let q = |a: f32, b: f32| if b != 0.0 { a / b } else { 0.0 };
+    let (mut x, mut y, mut z) = (q(a.x, b.x), q(a.y, b.y), q(a.z, b.z));
+    match (b.x == 0.0, b.y == 0.0, b.z == 0.0) {
+        (true, true, _) => (x, y) = (z, z),
+        (true, false, true) => (x, z) = (y, y),
+        (true, false, false) => x = 0.5 * (y + z),
+        (false, true, true) => (y, z) = (x, x),
+        (false, true, false) => y = 0.5 * (x + z),
+        (false, false, true) => z = 0.5 * (x + y),
+        (false, false, false) => {}
+    }
+    Vec3::new(x, y, z)
+}
+
+/// Turns a pixel's accumulated record `acc` (laid out by `acc_set`, which holds every pass of
+/// `out_set` and the Color passes its light passes need: [`PassSet::with_dividers`]) into the
+/// values of `out_set`'s passes in `out`: averages over `n` samples, light passes divided by
+/// their colour, and Blender's conventions for what was never written (Depth 1e10 where the
+/// camera saw no surface; Mist stored as `1 - value`). Noisy Image is left to the caller.
+pub fn resolve(acc_set: &PassSet, acc: &[f32], n: u32, out_set: &PassSet, out: &mut [f32]) {
     let inv = if n > 0 { 1.0 / n as f32 } else { 0.0 };
-    for (pass, at) in set.iter() {
+    let rgb = |at: usize| Vec3::new(acc[at], acc[at + 1], acc[at + 2]);
+    for (pass, to) in out_set.iter() {
+        let Some(at) = acc_set.offset(pass) else {
+            continue;
+        };
+        if let Some((class, _)) = pass.light() {
+            // Σ radiance / Σ colour: the sample counts cancel.
+            let col = acc_set.offset(class.passes().2).map_or(Vec3::ZERO, rgb);
+            let v = divide_even_color(rgb(at), col);
+            out[to..to + 3].copy_from_slice(&v.to_array());
+            continue;
+        }
         let k = pass.channels();
         for c in 0..k {
             let v = acc[at + c];
-            out[at + c] = match pass {
+            out[to + c] = match pass {
                 Pass::Depth => {
                     if v == 0.0 {
                         1e10

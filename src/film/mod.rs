@@ -4,12 +4,14 @@
 //! Every pixel keeps its own sums, added in sample order, so a render is the same for any
 //! thread count and any split into rounds (Combined is bit-identical to one long round).
 
+pub mod accumulators;
+pub mod color;
 pub mod data;
 pub mod filter;
 pub mod pass;
 
 pub use filter::{FilterType, PixelFilter};
-pub use pass::{Pass, PassSet};
+pub use pass::{LightClass, Pass, PassSet};
 
 use glam::Vec3;
 

@@ -27,10 +27,67 @@ pub enum Pass {
     DenoisingNormal,
     /// The denoiser's albedo feature: the summed closure albedo at the first surface.
     DenoisingAlbedo,
+    /// Cycles' light passes: the radiance that reached the camera through a first bounce of
+    /// that class (diffuse, glossy, transmission: the sampled closure's class, see
+    /// [`crate::bsdf::Bsdf::eval_split`]), *divided by the pass's colour* as Cycles shows it.
+    /// Direct is light sampled at the first bounce and emission met by the ray leaving it;
+    /// Indirect all that comes later. So `(Direct + Indirect) · Color` of the three classes,
+    /// plus Emission and Environment, is Combined: per pixel where the camera sees opaque
+    /// surfaces, in expectation through partly transparent ones (Emission and Environment
+    /// weight what lies behind by the transparency, a path picks it at random) or with
+    /// clamping (which Emission and Environment do not apply).
+    DiffuseDirect,
+    DiffuseIndirect,
+    /// The summed albedo of the diffuse closures (Cycles' `bsdf_albedo`) where the camera
+    /// path first scatters, weighted by the transparency in front.
+    DiffuseColor,
+    GlossyDirect,
+    GlossyIndirect,
+    /// The glossy closures' albedo (reflection part of glass lobes included).
+    GlossyColor,
+    TransmissionDirect,
+    TransmissionIndirect,
+    /// The transmission closures' albedo (refraction part of glass lobes included).
+    TransmissionColor,
+    /// Combined before denoising (Cycles registers it when the view layer is denoised).
+    NoisyImage,
+}
+
+/// The light-pass classes of a camera path's first bounce, in Cycles' order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightClass {
+    Diffuse = 0,
+    Glossy = 1,
+    Transmission = 2,
+}
+
+impl LightClass {
+    pub const ALL: [LightClass; 3] = [
+        LightClass::Diffuse,
+        LightClass::Glossy,
+        LightClass::Transmission,
+    ];
+
+    /// `(direct, indirect, color)` passes of the class.
+    pub fn passes(self) -> (Pass, Pass, Pass) {
+        match self {
+            LightClass::Diffuse => (
+                Pass::DiffuseDirect,
+                Pass::DiffuseIndirect,
+                Pass::DiffuseColor,
+            ),
+            LightClass::Glossy => (Pass::GlossyDirect, Pass::GlossyIndirect, Pass::GlossyColor),
+            LightClass::Transmission => (
+                Pass::TransmissionDirect,
+                Pass::TransmissionIndirect,
+                Pass::TransmissionColor,
+            ),
+        }
+    }
 }
 
 impl Pass {
-    pub const ALL: [Pass; 11] = [
+    pub const ALL: [Pass; 21] = [
         Pass::Depth,
         Pass::Mist,
         Pass::Normal,
@@ -42,6 +99,16 @@ impl Pass {
         Pass::Environment,
         Pass::DenoisingNormal,
         Pass::DenoisingAlbedo,
+        Pass::DiffuseDirect,
+        Pass::DiffuseIndirect,
+        Pass::DiffuseColor,
+        Pass::GlossyDirect,
+        Pass::GlossyIndirect,
+        Pass::GlossyColor,
+        Pass::TransmissionDirect,
+        Pass::TransmissionIndirect,
+        Pass::TransmissionColor,
+        Pass::NoisyImage,
     ];
 
     /// The command line's name (`--passes depth,normal,...`).
@@ -58,10 +125,20 @@ impl Pass {
             Pass::Environment => "environment",
             Pass::DenoisingNormal => "denoising_normal",
             Pass::DenoisingAlbedo => "denoising_albedo",
+            Pass::DiffuseDirect => "diffuse_direct",
+            Pass::DiffuseIndirect => "diffuse_indirect",
+            Pass::DiffuseColor => "diffuse_color",
+            Pass::GlossyDirect => "glossy_direct",
+            Pass::GlossyIndirect => "glossy_indirect",
+            Pass::GlossyColor => "glossy_color",
+            Pass::TransmissionDirect => "transmission_direct",
+            Pass::TransmissionIndirect => "transmission_indirect",
+            Pass::TransmissionColor => "transmission_color",
+            Pass::NoisyImage => "noisy_image",
         }
     }
 
-    /// Blender's render pass name.
+    /// Blender's render pass name (3.x's; the add-on maps it to later Blenders' names).
     pub fn blender_name(self) -> &'static str {
         match self {
             Pass::Depth => "Depth",
@@ -75,6 +152,16 @@ impl Pass {
             Pass::Environment => "Env",
             Pass::DenoisingNormal => "Denoising Normal",
             Pass::DenoisingAlbedo => "Denoising Albedo",
+            Pass::DiffuseDirect => "DiffDir",
+            Pass::DiffuseIndirect => "DiffInd",
+            Pass::DiffuseColor => "DiffCol",
+            Pass::GlossyDirect => "GlossDir",
+            Pass::GlossyIndirect => "GlossInd",
+            Pass::GlossyColor => "GlossCol",
+            Pass::TransmissionDirect => "TransDir",
+            Pass::TransmissionIndirect => "TransInd",
+            Pass::TransmissionColor => "TransCol",
+            Pass::NoisyImage => "Noisy Image",
         }
     }
 
@@ -85,6 +172,7 @@ impl Pass {
             Pass::ObjectIndex | Pass::MaterialIndex => "X",
             Pass::Normal | Pass::Position | Pass::DenoisingNormal => "XYZ",
             Pass::Uv => "UVA",
+            Pass::NoisyImage => "RGBA",
             _ => "RGB",
         }
     }
@@ -95,6 +183,14 @@ impl Pass {
 
     pub fn from_name(name: &str) -> Option<Pass> {
         Pass::ALL.into_iter().find(|p| p.name() == name)
+    }
+
+    /// The light class of a Direct or Indirect pass, and whether it is the direct one.
+    pub fn light(self) -> Option<(LightClass, bool)> {
+        LightClass::ALL.into_iter().find_map(|c| {
+            let (d, i, _) = c.passes();
+            (self == d || self == i).then_some((c, self == d))
+        })
     }
 
     /// Written by the pixel's first sample only, as Cycles writes it (an average of depths or
@@ -153,6 +249,24 @@ impl PassSet {
         set
     }
 
+    /// This set plus what its passes are computed from: the Color pass of every Direct or
+    /// Indirect pass (Cycles divides those by it when they are read).
+    pub fn with_dividers(&self) -> PassSet {
+        let need = |p: Pass| {
+            self.contains(p)
+                || LightClass::ALL.into_iter().any(|c| {
+                    let (d, i, col) = c.passes();
+                    p == col && (self.contains(d) || self.contains(i))
+                })
+        };
+        PassSet::new(Pass::ALL.into_iter().filter(|&p| need(p)))
+    }
+
+    /// True when any Direct or Indirect light pass is enabled.
+    pub fn has_light(&self) -> bool {
+        self.passes.iter().any(|p| p.light().is_some())
+    }
+
     pub fn is_empty(&self) -> bool {
         self.passes.is_empty()
     }
@@ -197,6 +311,21 @@ mod tests {
             vec![(Pass::Depth, 0), (Pass::Normal, 1), (Pass::Uv, 4)]
         );
         assert_eq!(s.stride(), 7);
+        let s = PassSet::parse(["glossy_indirect", "DiffDir", "depth"]).unwrap();
+        let full = s.with_dividers();
+        let names: Vec<_> = full.iter().map(|(p, _)| p.name()).collect();
+        assert_eq!(
+            names,
+            [
+                "depth",
+                "diffuse_direct",
+                "diffuse_color",
+                "glossy_indirect",
+                "glossy_color"
+            ]
+        );
+        assert_eq!(full.with_dividers(), full);
+        assert!(s.has_light() && !PassSet::parse(["diffuse_color"]).unwrap().has_light());
         let e = PassSet::parse(["depth", "shiny"]).unwrap_err();
         assert!(e.contains("`shiny`") && e.contains("object_index"), "{e}");
     }

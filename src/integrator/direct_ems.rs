@@ -7,7 +7,9 @@
 //! glass) has no density to sample a light against, so the surface shows only its emission:
 //! a mirror's reflection of a light is black.
 
-use super::{Integrator, MAX_TRANSPARENT, ShadingPoint, sample_emitter, spawn, trace_lit};
+use super::light_split::{ClassWeights, LightSplit, NoSplit, Sink};
+use super::path::report;
+use super::{Integrator, MAX_TRANSPARENT, ShadingPoint, sample_emitter_towards, spawn, trace_lit};
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
 
@@ -19,7 +21,37 @@ pub struct DirectEms {
 }
 
 impl Integrator for DirectEms {
-    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, mut o: Vec3, mut d: Vec3) -> Vec3 {
+    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
+        self.run(scene, ctx, o, d, &mut NoSplit)
+    }
+
+    fn splits_light(&self) -> bool {
+        true
+    }
+
+    fn li_split(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        split: &mut LightSplit,
+    ) -> Vec3 {
+        self.run(scene, ctx, o, d, split)
+    }
+}
+
+impl DirectEms {
+    #[inline(always)]
+    fn run<S: Sink>(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        mut o: Vec3,
+        mut d: Vec3,
+        sink: &mut S,
+    ) -> Vec3 {
+        let mut weights = ClassWeights::default();
         let mut l = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
@@ -29,9 +61,11 @@ impl Integrator for DirectEms {
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
             if let Some((_, le, _)) = emitted {
                 l += throughput * le;
+                report(sink, throughput * le, depth, &weights);
             }
             if lights != Vec3::ZERO {
                 l += throughput * lights;
+                report(sink, throughput * lights, depth, &weights);
             }
             let Some(its) = hit else {
                 return l;
@@ -54,15 +88,26 @@ impl Integrator for DirectEms {
                 continue;
             }
             if !sp.bsdf_is_delta() {
-                return l + throughput * sample_emitter(scene, ctx, &its, &sp, d, false);
+                let (e, towards) = sample_emitter_towards(scene, ctx, &its, &sp, d, false);
+                if S::ACTIVE && e != Vec3::ZERO {
+                    if depth == 1 {
+                        sink.bounced(throughput * e, &sp.class_weights_to(towards), true);
+                    } else {
+                        sink.bounced(throughput * e, &weights, false);
+                    }
+                }
+                return l + throughput * e;
             }
             if !self.follow_delta {
                 return l;
             }
             // Emitter sampling cannot see a delta BSDF: follow it.
-            let Some((wo, w, _)) = sp.sample(ctx, &its, d) else {
+            let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
                 return l;
             };
+            if S::ACTIVE && depth == 1 {
+                weights = sp.class_weights_sampled(&rec);
+            }
             throughput *= w;
             o = spawn(&its, wo);
             d = wo;

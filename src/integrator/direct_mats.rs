@@ -1,6 +1,8 @@
 //! Direct illumination by BSDF sampling (the seed's `direct_mats`): one BSDF sample at the
 //! first non-delta surface; its ray counts the radiance of whatever emitter it hits.
 
+use super::light_split::{ClassWeights, LightSplit, NoSplit, Sink};
+use super::path::report;
 use super::{Integrator, MAX_TRANSPARENT, ShadingPoint, spawn, trace_lit};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
@@ -11,7 +13,37 @@ pub struct DirectMats {
 }
 
 impl Integrator for DirectMats {
-    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, mut o: Vec3, mut d: Vec3) -> Vec3 {
+    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
+        self.run(scene, ctx, o, d, &mut NoSplit)
+    }
+
+    fn splits_light(&self) -> bool {
+        true
+    }
+
+    fn li_split(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        split: &mut LightSplit,
+    ) -> Vec3 {
+        self.run(scene, ctx, o, d, split)
+    }
+}
+
+impl DirectMats {
+    #[inline(always)]
+    fn run<S: Sink>(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        mut o: Vec3,
+        mut d: Vec3,
+        sink: &mut S,
+    ) -> Vec3 {
+        let mut weights = ClassWeights::default();
         let mut l = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
@@ -21,9 +53,11 @@ impl Integrator for DirectMats {
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
             if let Some((_, le, _)) = emitted {
                 l += throughput * le;
+                report(sink, throughput * le, depth, &weights);
             }
             if lights != Vec3::ZERO {
                 l += throughput * lights;
+                report(sink, throughput * lights, depth, &weights);
             }
             let Some(its) = hit else {
                 return l;
@@ -48,6 +82,9 @@ impl Integrator for DirectMats {
             let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
                 return l;
             };
+            if S::ACTIVE && depth == 1 {
+                weights = sp.class_weights_sampled(&rec);
+            }
             throughput *= w;
             o = spawn(&its, wo);
             d = wo;
@@ -57,9 +94,11 @@ impl Integrator for DirectMats {
                 let (_, emitted, lights) = trace_lit(scene, ctx, o, d, depth, true, f32::INFINITY);
                 if let Some((_, le, _)) = emitted {
                     l += throughput * le;
+                    report(sink, throughput * le, depth, &weights);
                 }
                 if lights != Vec3::ZERO {
                     l += throughput * lights;
+                    report(sink, throughput * lights, depth, &weights);
                 }
                 return l;
             }

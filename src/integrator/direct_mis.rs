@@ -3,8 +3,10 @@
 //! heuristic. Delta BSDF samples and delta lights get weight 1 (the other strategy cannot
 //! produce them). The light-choice probability is part of the emitter density on both sides.
 
+use super::light_split::{ClassWeights, LightSplit, NoSplit, Sink};
+use super::path::report;
 use super::{
-    Integrator, MAX_TRANSPARENT, ShadingPoint, mis_weight, sample_emitter, spawn, trace_lit,
+    Integrator, MAX_TRANSPARENT, ShadingPoint, mis_weight, sample_emitter_towards, spawn, trace_lit,
 };
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
@@ -15,7 +17,37 @@ pub struct DirectMis {
 }
 
 impl Integrator for DirectMis {
-    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, mut o: Vec3, mut d: Vec3) -> Vec3 {
+    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
+        self.run(scene, ctx, o, d, &mut NoSplit)
+    }
+
+    fn splits_light(&self) -> bool {
+        true
+    }
+
+    fn li_split(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        split: &mut LightSplit,
+    ) -> Vec3 {
+        self.run(scene, ctx, o, d, split)
+    }
+}
+
+impl DirectMis {
+    #[inline(always)]
+    fn run<S: Sink>(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        mut o: Vec3,
+        mut d: Vec3,
+        sink: &mut S,
+    ) -> Vec3 {
+        let mut weights = ClassWeights::default();
         let mut l = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
@@ -25,9 +57,11 @@ impl Integrator for DirectMis {
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
             if let Some((_, le, _)) = emitted {
                 l += throughput * le;
+                report(sink, throughput * le, depth, &weights);
             }
             if lights != Vec3::ZERO {
                 l += throughput * lights;
+                report(sink, throughput * lights, depth, &weights);
             }
             let Some(its) = hit else {
                 return l;
@@ -50,11 +84,22 @@ impl Integrator for DirectMis {
                 continue;
             }
             if !sp.bsdf_is_delta() {
-                l += throughput * sample_emitter(scene, ctx, &its, &sp, d, true);
+                let (e, towards) = sample_emitter_towards(scene, ctx, &its, &sp, d, true);
+                l += throughput * e;
+                if S::ACTIVE && e != Vec3::ZERO {
+                    if depth == 1 {
+                        sink.bounced(throughput * e, &sp.class_weights_to(towards), true);
+                    } else {
+                        sink.bounced(throughput * e, &weights, false);
+                    }
+                }
             }
             let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
                 return l;
             };
+            if S::ACTIVE && depth == 1 {
+                weights = sp.class_weights_sampled(&rec);
+            }
             throughput *= w;
             o = spawn(&its, wo);
             d = wo;
@@ -63,10 +108,13 @@ impl Integrator for DirectMis {
                 // The BSDF half of MIS at this vertex, then stop.
                 let (_, emitted, lights) = trace_lit(scene, ctx, o, d, depth, true, rec.pdf);
                 if let Some((e, le, erec)) = emitted {
-                    l += throughput * le * mis_weight(rec.pdf, scene.light_pdf(e, &erec));
+                    let c = throughput * le * mis_weight(rec.pdf, scene.light_pdf(e, &erec));
+                    l += c;
+                    report(sink, c, depth, &weights);
                 }
                 if lights != Vec3::ZERO {
                     l += throughput * lights;
+                    report(sink, throughput * lights, depth, &weights);
                 }
                 return l;
             }

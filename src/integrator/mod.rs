@@ -10,6 +10,7 @@ pub mod direct_ems;
 pub mod direct_mats;
 pub mod direct_mis;
 pub mod light_paths;
+pub mod light_split;
 pub mod path;
 pub mod scaled;
 
@@ -22,6 +23,26 @@ use glam::Vec3;
 /// One integrator: radiance along the unit-direction ray `o + t d`.
 pub trait Integrator: Send + Sync {
     fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3;
+
+    /// True for integrators that can split their radiance into Cycles' light passes.
+    fn splits_light(&self) -> bool {
+        false
+    }
+
+    /// [`Integrator::li`] (the same value, the same random numbers) with its parts added to
+    /// `split`; integrators that do not split put everything in `split.camera`.
+    fn li_split(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        split: &mut light_split::LightSplit,
+    ) -> Vec3 {
+        let l = self.li(scene, ctx, o, d);
+        split.camera += l;
+        l
+    }
 }
 
 /// The integrators selectable by name. `direct_ems_first_hit` is emitter sampling at the
@@ -89,6 +110,10 @@ pub struct ShadingPoint {
     /// The interpolated normal on the viewer's side when the closure's own normal differs
     /// from it (normal or bump map), for Cycles' bump shadowing; `None` otherwise.
     smooth: Option<Vec3>,
+    /// The frame of the glossy layer of a specular-over-diffuse BSDF when a normal or bump
+    /// map makes its normal differ from the diffuse one (Cycles raises a specular closure's
+    /// normal so that it reflects above the surface; the diffuse keeps the mapped one).
+    glossy_frame: Option<Frame>,
 }
 
 impl ShadingPoint {
@@ -117,55 +142,93 @@ impl ShadingPoint {
             if n.dot(its.ns) < 0.0 {
                 n = -n;
             }
-        } else if n.dot(-d) < 0.0 {
+        } else if closure.normal == Vec3::ZERO && n.dot(-d) < 0.0 {
+            // The interpolated normal on the viewer's side; a closure's own normal already
+            // is Cycles' N (flipped with the face), and stays as mapped even where it turns
+            // away from the viewer.
             n = -n;
         }
         if closure.normal != Vec3::ZERO
             && matches!(
                 bsdf,
-                BsdfInstance::Mirror(_) | BsdfInstance::RoughConductor(_)
+                BsdfInstance::Mirror(_)
+                    | BsdfInstance::RoughConductor(_)
+                    | BsdfInstance::Dielectric(_)
+                    | BsdfInstance::RoughDielectric(_)
             )
         {
-            // Specular reflection lobes (Glossy, metallic Principled) under a normal or bump
-            // map reflect above the geometric surface, as Cycles makes them.
+            // Specular lobes (Glossy, Glass, Refraction, metallic or transmissive Principled)
+            // under a normal or bump map reflect above the geometric surface, as Cycles makes
+            // them; a transmissive lobe's normal is raised on the viewer's side.
             let ng = if its.ng.dot(-d) < 0.0 {
                 -its.ng
             } else {
                 its.ng
             };
-            n = bsdf::closure::valid_specular_normal(ng, -d, n);
+            // (A transmissive lobe's normal points outwards; a reflective one's is Cycles' N.)
+            let flip = bsdf.is_transmissive() && n.dot(-d) < 0.0;
+            let m = bsdf::closure::valid_specular_normal(ng, -d, if flip { -n } else { n });
+            n = if flip { -m } else { m };
         }
-        let frame = match anisotropic_rotation(&closure.kind) {
-            Some(rotation) => {
-                let t = if closure.tangent == Vec3::ZERO {
-                    scene
-                        .globals(its, d, depth, 0)
-                        .tangent()
-                        .map_or(Vec3::ZERO, |(t, _)| {
-                            crate::shading::globals::from_blender(t)
-                        })
-                } else {
-                    closure.tangent
-                };
-                tangent_frame(n, t, rotation)
-            }
+        let rotation = anisotropic_rotation(&closure.kind);
+        let tangent = match rotation {
+            Some(_) if closure.tangent == Vec3::ZERO => scene
+                .globals(its, d, depth, 0)
+                .tangent()
+                .map_or(Vec3::ZERO, |(t, _)| {
+                    crate::shading::globals::from_blender(t)
+                }),
+            _ => closure.tangent,
+        };
+        let frame_of = |n: Vec3| match rotation {
+            Some(rotation) => tangent_frame(n, tangent, rotation),
             None => Frame::from_normal(n),
         };
-        let smooth = (closure.normal != Vec3::ZERO).then(|| {
-            if its.ns.dot(-d) < 0.0 {
-                -its.ns
-            } else {
-                its.ns
+        let frame = frame_of(n);
+        let glossy_frame = match &bsdf {
+            BsdfInstance::Layered(l)
+                if closure.normal != Vec3::ZERO
+                    && matches!(
+                        (&l.top, &l.base),
+                        (
+                            bsdf::layered::TopLobe::Specular(_),
+                            bsdf::layered::BaseLobe::Diffuse(_)
+                        )
+                    ) =>
+            {
+                let ng = if its.ng.dot(-d) < 0.0 {
+                    -its.ng
+                } else {
+                    its.ng
+                };
+                let m = bsdf::closure::valid_specular_normal(ng, -d, n);
+                (m != n).then(|| frame_of(m))
             }
+            _ => None,
+        };
+        let smooth = (closure.normal != Vec3::ZERO).then(|| {
+            let ns = if closure.surface_normal == Vec3::ZERO {
+                its.ns
+            } else {
+                closure.surface_normal
+            };
+            if ns.dot(-d) < 0.0 { -ns } else { ns }
         });
+        let wi = frame.to_local(-d);
+        let mut bsdf = bsdf;
+        if let BsdfInstance::Layered(l) = &mut bsdf {
+            // The layering for the direction its top lobe is queried with.
+            l.prepare(glossy_frame.as_ref().map_or(wi, |g| g.to_local(-d)));
+        }
         Some(ShadingPoint {
             smooth,
+            glossy_frame,
             passes: matches!(
                 closure.kind,
                 crate::shading::ClosureKind::Transparent { .. }
             ),
             bsdf,
-            wi: frame.to_local(-d),
+            wi,
             frame,
             weight: closure.weight * inv_p,
         })
@@ -192,6 +255,21 @@ impl ShadingPoint {
         }
     }
 
+    /// Light-pass weights of light arriving from world direction `wo` (emitter sampling).
+    #[inline]
+    pub fn class_weights_to(&self, wo: Vec3) -> light_split::ClassWeights {
+        light_split::ClassWeights::of(
+            &self.bsdf,
+            &BsdfQueryRecord::pair(self.wi, self.frame.to_local(wo)),
+        )
+    }
+
+    /// Light-pass weights of the direction `sample` returned with `rec`.
+    #[inline]
+    pub fn class_weights_sampled(&self, rec: &BsdfQueryRecord) -> light_split::ClassWeights {
+        light_split::ClassWeights::of(&self.bsdf, rec)
+    }
+
     /// True when the chosen BSDF is purely specular.
     #[inline]
     pub fn bsdf_is_delta(&self) -> bool {
@@ -206,11 +284,109 @@ impl ShadingPoint {
         if !self.bsdf.is_transmissive() && its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
             return Vec3::ZERO;
         }
-        let f = self.bsdf.eval(&BsdfQueryRecord::pair(self.wi, lo)) * lo.z.abs() * self.weight;
-        match self.smooth {
-            Some(ns) => f * self.bump_shadowing(ns, wo, true),
-            None => f,
+        if let Some(g) = &self.glossy_frame {
+            return self.two_frame_eval_cos(g, d, wo, true) * self.weight;
         }
+        let rec = BsdfQueryRecord::pair(self.wi, lo);
+        match self.smooth {
+            Some(ns) => self.bumped_eval(&rec, ns, wo, true) * lo.z.abs() * self.weight,
+            None => self.bsdf.eval(&rec) * lo.z.abs() * self.weight,
+        }
+    }
+
+    /// The BSDF at `rec` (per steradian) with the bump corrections for a closure normal off
+    /// the interpolated one `ns`; a diffuse base under a glossy coat is corrected as the
+    /// diffuse closure it is in Cycles, the coat as a glossy one.
+    #[inline]
+    fn bumped_eval(&self, rec: &BsdfQueryRecord, ns: Vec3, wo: Vec3, is_eval: bool) -> Vec3 {
+        match self.bsdf.diffuse_parts(rec) {
+            Some((base, coat)) => {
+                base * self.bump_shadowing(ns, wo, is_eval, true)
+                    + coat * self.bump_shadowing(ns, wo, is_eval, false)
+            }
+            None => self.bsdf.eval(rec) * self.bump_shadowing(ns, wo, is_eval, self.diffuse_lobe()),
+        }
+    }
+
+    /// `f · |cos|` (without the closure weight) of a specular layer in frame `g` over the
+    /// diffuse base in `self.frame`, each with its own normal's cosine and bump correction, as
+    /// Cycles' two closures: `A(wi_g) f_d(wi, wo) |n·wo| + f_s(wi_g, wo_g) |m·wo|`.
+    #[inline]
+    fn two_frame_eval_cos(&self, g: &Frame, d: Vec3, wo: Vec3, is_eval: bool) -> Vec3 {
+        let BsdfInstance::Layered(l) = &self.bsdf else {
+            return Vec3::ZERO;
+        };
+        let ns = self.smooth.unwrap_or(self.frame.n);
+        let (wi_g, wo_g, lo) = (g.to_local(-d), g.to_local(wo), self.frame.to_local(wo));
+        let att = l.attenuation_at(wi_g);
+        let base = att
+            * l.base.eval(&BsdfQueryRecord::pair(self.wi, lo))
+            * lo.z.abs()
+            * Self::bump_term(self.frame.n, ns, wo, is_eval, true);
+        let top = l.top.eval(&BsdfQueryRecord::pair(wi_g, wo_g))
+            * wo_g.z.abs()
+            * Self::bump_term(g.n, ns, wo, is_eval, false);
+        base + top
+    }
+
+    /// The density (per steradian) of [`Self::two_frame_eval_cos`]'s sampling: the glossy
+    /// layer with Layered's probability `p(wi_g)`, else the base.
+    #[inline]
+    fn two_frame_pdf(&self, g: &Frame, d: Vec3, wo: Vec3) -> f32 {
+        let BsdfInstance::Layered(l) = &self.bsdf else {
+            return 0.0;
+        };
+        let wi_g = g.to_local(-d);
+        let p = l.top_probability(wi_g);
+        p * l.top.pdf(&BsdfQueryRecord::pair(wi_g, g.to_local(wo)))
+            + (1.0 - p)
+                * l.base
+                    .pdf(&BsdfQueryRecord::pair(self.wi, self.frame.to_local(wo)))
+    }
+
+    /// Samples the two-frame pair: `(world direction, f cos / pdf without the weight)`.
+    #[inline]
+    fn two_frame_sample(
+        &self,
+        g: &Frame,
+        d: Vec3,
+        u: glam::Vec2,
+        u1: f32,
+    ) -> Option<(Vec3, BsdfQueryRecord)> {
+        let BsdfInstance::Layered(l) = &self.bsdf else {
+            return None;
+        };
+        let wi_g = g.to_local(-d);
+        let p = l.top_probability(wi_g);
+        let (frame, mut rec) = if u1 < p {
+            (g, BsdfQueryRecord::new(wi_g))
+        } else {
+            (&self.frame, BsdfQueryRecord::new(self.wi))
+        };
+        let w = if u1 < p {
+            l.top
+                .sample(&mut rec, u, (u1 / p).min(1.0 - f32::EPSILON / 2.0))
+        } else {
+            let u1 = ((u1 - p) / (1.0 - p)).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+            l.base.sample(&mut rec, u, u1)
+        };
+        if w == Vec3::ZERO {
+            return None;
+        }
+        let wo = frame.to_world(rec.wo);
+        rec.wo = self.frame.to_local(wo);
+        rec.wi = self.wi;
+        rec.pdf = self.two_frame_pdf(g, d, wo);
+        (rec.pdf > 0.0 && rec.pdf.is_finite()).then_some((wo, rec))
+    }
+
+    /// The chosen BSDF is one of Cycles' diffuse closures (`CLOSURE_IS_BSDF_DIFFUSE`).
+    #[inline]
+    fn diffuse_lobe(&self) -> bool {
+        matches!(
+            self.bsdf,
+            BsdfInstance::Diffuse(_) | BsdfInstance::Translucent(_)
+        )
     }
 
     /// Cycles' correction for a closure normal that differs from the interpolated one `ns`
@@ -218,13 +394,14 @@ impl ShadingPoint {
     /// lies on the wrong side of the interpolated surface for the closure's normal (for
     /// evaluation, and for diffuse lobes always), and for diffuse lobes a GGX shadowing term
     /// (Chiang et al. 2019) with `α² = tan²(N, Ns) / 8` that darkens the terminator smoothly.
-    fn bump_shadowing(&self, ns: Vec3, wo: Vec3, is_eval: bool) -> f32 {
-        let n = self.frame.n;
+    fn bump_shadowing(&self, ns: Vec3, wo: Vec3, is_eval: bool, diffuse: bool) -> f32 {
+        Self::bump_term(self.frame.n, ns, wo, is_eval, diffuse)
+    }
+
+    /// [`Self::bump_shadowing`] for a closure with unit normal `n`.
+    #[inline]
+    fn bump_term(n: Vec3, ns: Vec3, wo: Vec3, is_eval: bool, diffuse: bool) -> f32 {
         let (cos_nsi, cos_nsn, cos_ni) = (ns.dot(wo), ns.dot(n), n.dot(wo));
-        let diffuse = matches!(
-            self.bsdf,
-            BsdfInstance::Diffuse(_) | BsdfInstance::Translucent(_)
-        );
         if cos_nsi * cos_nsn * cos_ni < 0.0 && (is_eval || diffuse) {
             return 0.0;
         }
@@ -266,6 +443,9 @@ impl ShadingPoint {
     /// BSDF density of world direction `wo` (per steradian).
     #[inline]
     pub fn pdf(&self, wo: Vec3) -> f32 {
+        if let Some(g) = &self.glossy_frame {
+            return self.two_frame_pdf(g, self.frame.to_world(-self.wi), wo);
+        }
         self.bsdf
             .pdf(&BsdfQueryRecord::pair(self.wi, self.frame.to_local(wo)))
     }
@@ -281,20 +461,36 @@ impl ShadingPoint {
         let mut rec = BsdfQueryRecord::new(self.wi);
         let u = ctx.sampler.next_2d();
         let u1 = ctx.sampler.next_1d();
+        if let Some(g) = &self.glossy_frame {
+            let (wo, rec) = self.two_frame_sample(g, d, u, u1)?;
+            ctx.ray_flags = self.ray_flags(&rec, true);
+            if its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
+                return None;
+            }
+            let w = self.two_frame_eval_cos(g, d, wo, false) / rec.pdf * self.weight;
+            return (w != Vec3::ZERO && w.is_finite()).then_some((wo, w, rec));
+        }
         let w = self.bsdf.sample(&mut rec, u, u1) * self.weight;
         if w == Vec3::ZERO || !w.is_finite() {
             return None;
         }
         let wo = self.frame.to_world(rec.wo);
         // A reflection must leave on the viewer's side of the true surface.
-        let reflect = rec.wo.z * self.wi.z > 0.0;
+        let reflect = !self.bsdf.is_transmissive() || rec.wo.z * self.wi.z > 0.0;
         ctx.ray_flags = self.ray_flags(&rec, reflect);
         if reflect && its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
             return None;
         }
-        let w = match self.smooth {
-            Some(ns) => w * self.bump_shadowing(ns, wo, false),
-            None => w,
+        let w = match (self.smooth, &self.bsdf) {
+            // The mixture's weight re-evaluated with each part corrected on its own.
+            (Some(ns), BsdfInstance::Plastic(_) | BsdfInstance::Layered(_))
+                if rec.measure == bsdf::Measure::SolidAngle
+                    && self.bsdf.diffuse_parts(&rec).is_some() =>
+            {
+                self.bumped_eval(&rec, ns, wo, false) * rec.wo.z.abs() / rec.pdf * self.weight
+            }
+            (Some(ns), _) => w * self.bump_shadowing(ns, wo, false, self.diffuse_lobe()),
+            (None, _) => w,
         };
         if w == Vec3::ZERO {
             return None;
@@ -362,15 +558,29 @@ pub fn sample_emitter(
     d: Vec3,
     mis: bool,
 ) -> Vec3 {
+    sample_emitter_towards(scene, ctx, its, sp, d, mis).0
+}
+
+/// [`sample_emitter`] and the world direction towards the light sample (zero when none).
+#[inline]
+pub fn sample_emitter_towards(
+    scene: &RenderScene,
+    ctx: &mut Ctx,
+    its: &Intersection,
+    sp: &ShadingPoint,
+    d: Vec3,
+    mis: bool,
+) -> (Vec3, Vec3) {
+    let none = (Vec3::ZERO, Vec3::ZERO);
     let uc = ctx.sampler.next_1d();
     let u = ctx.sampler.next_2d();
     let (light, rec, weight) = scene.sample_light(its.p, uc, u);
     if weight == Vec3::ZERO || !scene.light_reaches(light, sp.light_class()) {
-        return Vec3::ZERO;
+        return none;
     }
     let f = sp.eval_cos(its, d, rec.wi);
     if f == Vec3::ZERO {
-        return Vec3::ZERO;
+        return none;
     }
     let tr = if scene.casts_shadow(light) {
         scene.transmittance(ctx, its.p, its.ng, &rec)
@@ -378,14 +588,14 @@ pub fn sample_emitter(
         Vec3::ONE
     };
     if tr == Vec3::ZERO {
-        return Vec3::ZERO;
+        return none;
     }
     let w = if mis && scene.light_uses_mis(light) {
         mis_weight(rec.pdf, sp.pdf(rec.wi))
     } else {
         1.0
     };
-    f * weight * w * tr
+    (f * weight * w * tr, rec.wi)
 }
 
 /// Traces the ray leaving path vertex `depth - 1` and returns the surface it hits (if any) with

@@ -3,7 +3,8 @@
 //! throughput's **maximum** component, survival probability capped at 0.95.
 
 use super::light_paths::{BounceCount, LightPaths};
-use super::{Integrator, ShadingPoint, mis_weight, sample_emitter, spawn, trace_lit};
+use super::light_split::{ClassWeights, LightSplit, NoSplit, Sink};
+use super::{Integrator, ShadingPoint, mis_weight, sample_emitter_towards, spawn, trace_lit};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
@@ -21,6 +22,19 @@ pub struct PathMis {
     pub paths: LightPaths,
 }
 
+/// Reports contribution `c` met at path vertex `depth` (1: the camera ray's hit) to `sink`;
+/// `w` are the first bounce's weights (unused before it).
+#[inline(always)]
+pub(super) fn report<S: Sink>(sink: &mut S, c: Vec3, depth: u32, w: &ClassWeights) {
+    if S::ACTIVE {
+        if depth <= 1 {
+            sink.camera(c);
+        } else {
+            sink.bounced(c, w, depth == 2);
+        }
+    }
+}
+
 /// Russian roulette: returns false to terminate, else rescales `throughput`.
 #[inline]
 fn roulette(ctx: &mut Ctx, depth: u32, throughput: &mut Vec3) -> bool {
@@ -36,7 +50,37 @@ fn roulette(ctx: &mut Ctx, depth: u32, throughput: &mut Vec3) -> bool {
 }
 
 impl Integrator for PathMats {
-    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, mut o: Vec3, mut d: Vec3) -> Vec3 {
+    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
+        self.run(scene, ctx, o, d, &mut NoSplit)
+    }
+
+    fn splits_light(&self) -> bool {
+        true
+    }
+
+    fn li_split(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        split: &mut LightSplit,
+    ) -> Vec3 {
+        self.run(scene, ctx, o, d, split)
+    }
+}
+
+impl PathMats {
+    #[inline(always)]
+    fn run<S: Sink>(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        mut o: Vec3,
+        mut d: Vec3,
+        sink: &mut S,
+    ) -> Vec3 {
+        let mut weights = ClassWeights::default();
         let mut l = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
@@ -47,10 +91,14 @@ impl Integrator for PathMats {
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
             let direct = depth <= 2;
             if let Some((_, le, _)) = emitted {
-                l += self.paths.clamp(throughput * le, direct);
+                let c = self.paths.clamp(throughput * le, direct);
+                l += c;
+                report(sink, c, depth, &weights);
             }
             if lights != Vec3::ZERO {
-                l += self.paths.clamp(throughput * lights, direct);
+                let c = self.paths.clamp(throughput * lights, direct);
+                l += c;
+                report(sink, c, depth, &weights);
             }
             let Some(its) = hit else {
                 return l;
@@ -72,9 +120,12 @@ impl Integrator for PathMats {
                 o = spawn(&its, d);
                 continue;
             }
-            let Some((wo, w, _)) = sp.sample(ctx, &its, d) else {
+            let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
                 return l;
             };
+            if S::ACTIVE && depth == 1 {
+                weights = sp.class_weights_sampled(&rec);
+            }
             throughput *= w;
             // `sample` left the new ray's Light Path bits in the context.
             if counts.count(ctx.ray_flags, &self.paths) {
@@ -88,7 +139,37 @@ impl Integrator for PathMats {
 }
 
 impl Integrator for PathMis {
-    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, mut o: Vec3, mut d: Vec3) -> Vec3 {
+    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
+        self.run(scene, ctx, o, d, &mut NoSplit)
+    }
+
+    fn splits_light(&self) -> bool {
+        true
+    }
+
+    fn li_split(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        split: &mut LightSplit,
+    ) -> Vec3 {
+        self.run(scene, ctx, o, d, split)
+    }
+}
+
+impl PathMis {
+    #[inline(always)]
+    fn run<S: Sink>(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        mut o: Vec3,
+        mut d: Vec3,
+        sink: &mut S,
+    ) -> Vec3 {
+        let mut weights = ClassWeights::default();
         let mut l = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
@@ -106,10 +187,14 @@ impl Integrator for PathMis {
                 } else {
                     mis_weight(bsdf_pdf, scene.light_pdf(e, &erec))
                 };
-                l += self.paths.clamp(throughput * le * w, depth <= 2);
+                let c = self.paths.clamp(throughput * le * w, depth <= 2);
+                l += c;
+                report(sink, c, depth, &weights);
             }
             if lights != Vec3::ZERO {
-                l += self.paths.clamp(throughput * lights, depth <= 2);
+                let c = self.paths.clamp(throughput * lights, depth <= 2);
+                l += c;
+                report(sink, c, depth, &weights);
             }
             let Some(its) = hit else {
                 return l;
@@ -132,12 +217,23 @@ impl Integrator for PathMis {
                 continue;
             }
             if !sp.bsdf_is_delta() {
-                let ls = throughput * sample_emitter(scene, ctx, &its, &sp, d, true);
-                l += self.paths.clamp(ls, depth == 1);
+                let (e, towards) = sample_emitter_towards(scene, ctx, &its, &sp, d, true);
+                let ls = self.paths.clamp(throughput * e, depth == 1);
+                l += ls;
+                if S::ACTIVE && ls != Vec3::ZERO {
+                    if depth == 1 {
+                        sink.bounced(ls, &sp.class_weights_to(towards), true);
+                    } else {
+                        sink.bounced(ls, &weights, false);
+                    }
+                }
             }
             let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
                 return l;
             };
+            if S::ACTIVE && depth == 1 {
+                weights = sp.class_weights_sampled(&rec);
+            }
             bsdf_pdf = if rec.measure == Measure::Discrete {
                 f32::INFINITY
             } else {

@@ -86,6 +86,9 @@ pub struct Closure {
     pub normal: Vec3,
     /// Unit tangent (world space) for anisotropic lobes; zero when the mesh has none.
     pub tangent: Vec3,
+    /// The surface normal Cycles' bump corrections compare `normal` with (its `sd->N`), world
+    /// space: zero for the interpolated normal, else the normal a displacement made.
+    pub surface_normal: Vec3,
     pub kind: ClosureKind,
 }
 
@@ -102,6 +105,7 @@ const EMPTY: Closure = Closure {
     weight: Vec3::ZERO,
     normal: Vec3::Z,
     tangent: Vec3::ZERO,
+    surface_normal: Vec3::ZERO,
     kind: ClosureKind::Diffuse { color: Vec3::ZERO },
 };
 

@@ -75,6 +75,8 @@ pub struct Compiler<'g> {
     may_pass: bool,
     /// Whether any operation depends on the shading point (else the closures are constant).
     varying: bool,
+    /// A displacement replaced `N`: closures without a Normal input take the displaced one.
+    displaced: bool,
 }
 
 /// The result of compiling a material.
@@ -98,17 +100,14 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
         may_emit: false,
         may_pass: false,
         varying: false,
+        displaced: false,
     };
+    if let Some((node, output)) = &graph.displacement {
+        c.displacement_as_bump(*node, output)?;
+    }
     if let Some((node, output)) = &graph.surface {
         let one = c.constant(&[1.0])?;
         c.shader_link(*node, output, one)?;
-    }
-    if let Some((node, _)) = &graph.displacement {
-        let n = &graph.nodes[*node];
-        c.warn(format!(
-            "material '{}': displacement from node '{}' ({}) is not rendered yet",
-            material, n.name, n.kind
-        ));
     }
     let mut program = Program {
         ops: c.ops,
@@ -142,6 +141,41 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
 }
 
 impl<'g> Compiler<'g> {
+    /// The material output's Displacement as Cycles' "Bump Only": the displacement vector at
+    /// the point and its two offsets, the displaced normal from them, and a Set Normal that
+    /// the surface graph (compiled afterwards, from scratch) sees as `N`. True displacement of
+    /// the vertices is not rendered: reported.
+    fn displacement_as_bump(&mut self, node: usize, output: &str) -> Result<()> {
+        let method = self.graph.displacement_method.as_str();
+        if method != "BUMP" {
+            let n = &self.graph.nodes[node];
+            self.warn(format!(
+                "material '{}': displacement method {method} from node '{}' ({}): the                  vertices are not displaced, the displacement is rendered as bump only",
+                self.material, n.name, n.kind
+            ));
+        }
+        let center = self.link(node, output, SocketType::Vector)?;
+        let mut d = [center; 3];
+        for axis in [1u8, 2] {
+            self.push(Op::Bump(nodes::bump::BumpOp::Enter { axis }), true);
+            self.bump = axis;
+            let r = self.link(node, output, SocketType::Vector);
+            self.bump = 0;
+            self.push(Op::Bump(nodes::bump::BumpOp::Leave), true);
+            d[axis as usize] = r?;
+        }
+        let n = self.alloc(3)?;
+        self.push(
+            Op::Displacement(nodes::displacement::DisplacementOp::Normal { d, out: n }),
+            true,
+        );
+        self.push(Op::Bump(nodes::bump::BumpOp::SetNormal { n }), true);
+        // The surface reads N after the Set Normal: its nodes are compiled anew.
+        self.state.clear();
+        self.displaced = true;
+        Ok(())
+    }
+
     fn warn(&mut self, msg: String) {
         if !self.warnings.contains(&msg) {
             self.warnings.push(msg);
@@ -346,6 +380,11 @@ impl<'g> NodeCx<'_, 'g> {
     /// node again for it.
     pub fn partial(&mut self) {
         self.partial = true;
+    }
+
+    /// The material's displacement replaced the shading normal `N`.
+    pub fn displaced(&self) -> bool {
+        self.c.displaced
     }
 
     pub fn is_linked(&self, id: &str) -> bool {

@@ -46,6 +46,8 @@ pub struct ShaderGlobals<'a> {
     pub p: Vec3,
     /// Unit shading normal, flipped to the side the ray came from (Cycles' `N`).
     pub n: Vec3,
+    /// `n` is no longer the interpolated normal: a displacement rendered as bump replaced it.
+    pub n_displaced: bool,
     /// Unit geometric normal, on the same side as `n`.
     pub ng: Vec3,
     /// Unit direction from the point towards the ray's origin (Cycles' `I`).
@@ -78,6 +80,7 @@ impl<'a> ShaderGlobals<'a> {
         ShaderGlobals {
             p,
             n,
+            n_displaced: false,
             ng: n,
             i: n,
             backfacing: false,
@@ -178,6 +181,24 @@ impl<'a> ShaderGlobals<'a> {
             Some(i) => m.attrs.to_object * i.to_world.inverse(),
             None => m.attrs.to_object,
         })
+    }
+
+    /// The linear part of the object → world map (object axes as the add-on wrote them, the
+    /// renderer's world axes), when on an object with an invertible transform.
+    #[inline]
+    pub fn object_to_world_linear(&self) -> Option<glam::Mat3> {
+        let a = glam::Mat3::from_mat4(self.to_object()?).inverse();
+        a.is_finite().then_some(a)
+    }
+
+    /// A world normal `n` (Blender axes) in object space, unit (Cycles'
+    /// `object_inverse_normal_transform`: the transposed object map); `n` off an object.
+    #[inline]
+    pub fn normal_to_object(&self, n: Vec3) -> Vec3 {
+        match self.object_to_world_linear() {
+            Some(a) => (a.transpose() * from_blender(n)).normalize_or_zero(),
+            None => n,
+        }
     }
 
     /// Blender's Object Info of the point's object (the instance's own, if placed).

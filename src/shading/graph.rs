@@ -81,6 +81,9 @@ pub struct Graph {
     pub surface: Option<(usize, String)>,
     /// What reaches the material output's Displacement.
     pub displacement: Option<(usize, String)>,
+    /// The material's displacement method: `"BUMP"` (Blender's default, also when absent),
+    /// `"DISPLACEMENT"` or `"BOTH"`.
+    pub displacement_method: String,
 }
 
 impl Graph {
@@ -164,6 +167,11 @@ impl Graph {
         Ok(Graph {
             surface: output("surface")?,
             displacement: output("displacement")?,
+            displacement_method: match obj.get("displacement_method") {
+                None | Some(Value::Null) => "BUMP".to_string(),
+                Some(Value::String(m)) => m.clone(),
+                Some(v) => return Err(format!("`displacement_method` is not a string: {v}")),
+            },
             nodes,
         })
     }

@@ -53,6 +53,7 @@ pub enum Op {
     Texture(nodes::texture::TextureOp),
     Utility(nodes::utility::UtilityOp),
     Bump(nodes::bump::BumpOp),
+    Displacement(nodes::displacement::DisplacementOp),
     Environment(nodes::environment::EnvironmentOp),
 }
 
@@ -62,12 +63,13 @@ impl Op {
         match self {
             Op::Closure(op) => op.eval(s, g, out),
             Op::Input(op) => op.eval(s, g, env),
-            Op::Image(op) => op.eval(s, env),
+            Op::Image(op) => op.eval(s, g, env),
             Op::Vector(op) => op.eval(s, g),
             Op::Convert(op) => op.eval(s),
             Op::Texture(op) => op.eval(s),
             Op::Utility(op) => op.eval(s),
             Op::Bump(op) => op.eval(s, g),
+            Op::Displacement(op) => op.eval(s, g),
             Op::Environment(op) => op.eval(s, env),
         }
     }
@@ -120,11 +122,25 @@ impl Program {
         // Bump nodes evaluate their height at offset points: operations between Enter and
         // Leave see the moved point.
         let mut moved: Option<ShaderGlobals> = None;
+        // A displacement rendered as bump replaces the normal the rest of the graph sees.
+        let mut base = *g;
         for op in &self.ops {
             match op {
-                Op::Bump(nodes::bump::BumpOp::Enter { axis }) => moved = Some(g.offset(*axis)),
+                Op::Bump(nodes::bump::BumpOp::Enter { axis }) => moved = Some(base.offset(*axis)),
                 Op::Bump(nodes::bump::BumpOp::Leave) => moved = None,
-                _ => op.eval(&mut s, moved.as_ref().unwrap_or(g), env, &mut scratch.set),
+                Op::Bump(nodes::bump::BumpOp::SetNormal { n }) => {
+                    let v = s.v(*n);
+                    if v.is_finite() && v != Vec3::ZERO {
+                        base.n = v;
+                        base.n_displaced = true;
+                    }
+                }
+                _ => op.eval(
+                    &mut s,
+                    moved.as_ref().unwrap_or(&base),
+                    env,
+                    &mut scratch.set,
+                ),
             }
         }
     }

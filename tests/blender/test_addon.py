@@ -311,6 +311,7 @@ def test_render_pixels_orientation_and_percentage(addon, fake, private_tmp, tmp_
     assert argv[argv.index("--width") + 1] == "24" and argv[argv.index("--height") + 1] == "18"
     assert argv[argv.index("--integrator") + 1] == "path_mis"
     assert argv[argv.index("--spp") + 1] == "4" and argv[argv.index("--max-depth") + 1] == "4"
+    assert argv[argv.index("--tile-size") + 1] == "32"  # the panel's default
     assert "--region" not in argv
     assert run["bin_exists"] and run["has_camera"]
     assert os.listdir(private_tmp) == []
@@ -968,3 +969,34 @@ def test_animated_seed_adds_the_frame():
     S.use_animated_seed = True
     assert tesela_engine.render_seed(S, 12) == 19
     assert tesela_engine.render_seed(S, -20) == 0
+
+
+def test_light_passes_are_registered_with_blenders_names_and_channels():
+    from types import SimpleNamespace
+    from blender_addon import passes
+    toggles = {t: True for t, *_ in passes.PASSES}
+    toggles["use_pass_shadow"] = True
+    layer = SimpleNamespace(cycles=SimpleNamespace(use_denoising=True,
+                                                   denoising_store_passes=False), **toggles)
+    settings = SimpleNamespace(integrator="path_mis", use_denoising=True)
+    got = {b: (name, ids, kind) for name, b, ids, kind in passes.enabled(layer, settings)}
+    assert got["DiffDir"] == ("diffuse_direct", "RGB", "COLOR")
+    assert got["TransCol"] == ("transmission_color", "RGB", "COLOR")
+    assert got["Noisy Image"] == ("noisy_image", "RGBA", "COLOR")
+    assert passes.unsupported(layer, settings) == ["Shadow"]
+    # A view layer that opts out of denoising has no Noisy Image; neither has a render without
+    # denoising.
+    layer.cycles.use_denoising = False
+    assert "Noisy Image" not in {b for _, b, _, _ in passes.enabled(layer, settings)}
+    # An integrator that does not split its light: Direct/Indirect are left out and said so,
+    # the Color passes stay.
+    settings.integrator = "normals"
+    names = {b for _, b, _, _ in passes.enabled(layer, settings)}
+    assert "DiffCol" in names and "DiffDir" not in names and "GlossInd" not in names
+    assert set(passes.unsupported(layer, settings)) == {
+        "Shadow", "DiffDir", "DiffInd", "GlossDir", "GlossInd", "TransDir", "TransInd"}
+    # Blender 4.2+ names through compat.
+    from blender_addon import compat
+    if bpy.app.version >= (4, 2, 0):
+        assert compat.pass_name("GlossInd") == "Glossy Indirect"
+        assert compat.pass_name("Noisy Image") == "Noisy Image"

@@ -104,6 +104,7 @@ def test_background_renderer_error(env34):
     env = dict(env, FAKE_TESELA_MODE="error")
     p, tmp, out = render_b(base, env, blend, FAKE, "error", ["-f", "1"])
     assert "out of memory while building the BVH" in p.stdout + p.stderr
+    assert p.returncode != 0  # a farm sees the frame fail
     assert leftovers(tmp) == []
 
 

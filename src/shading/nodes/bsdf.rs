@@ -142,11 +142,17 @@ impl ClosureOp {
             })
         };
         let col = |c: Slot| s.v(c).max(Vec3::ZERO);
+        let surface_normal = if g.n_displaced {
+            world_normal(g.n, g)
+        } else {
+            Vec3::ZERO
+        };
         let push = |out: &mut ClosureSet, weight: Vec3, normal: Vec3, tangent: Vec3, kind| {
             out.push(Closure {
                 weight,
                 normal,
                 tangent,
+                surface_normal,
                 kind,
             })
         };
@@ -246,21 +252,23 @@ impl ClosureOp {
                     s.f(*roughness).clamp(0.0, 1.0),
                     s.f(*ior).clamp(1e-3, 1e3),
                 );
+                // Blender's Glass and Refraction tint every reflection and refraction by
+                // their colour: it is the closure's weight, as for Glossy.
                 let kind = if *refraction_only {
                     ClosureKind::Refraction {
-                        color,
+                        color: Vec3::ONE,
                         roughness,
                         ior,
                     }
                 } else {
                     ClosureKind::Glass {
-                        color,
+                        color: Vec3::ONE,
                         roughness,
                         ior,
                         multiscatter: *multiscatter,
                     }
                 };
-                push(out, Vec3::splat(w), normal(*n), Vec3::ZERO, kind);
+                push(out, color * w, normal(*n), Vec3::ZERO, kind);
             }
             ClosureParams::Translucent { color, normal: n } => push(
                 out,
@@ -302,6 +310,17 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
     let normal = |cx: &mut NodeCx, id: &str| -> Result<Option<Slot>, CompileError> {
         if cx.is_linked(id) {
             cx.vector(id, Vec3::ZERO).map(Some)
+        } else if cx.displaced() && id != "Tangent" {
+            // Unlinked, the normal is N: after a displacement, the displaced one.
+            let n = cx.alloc(3)?;
+            cx.emit(
+                Op::Input(super::input::InputOp {
+                    src: super::input::Source::Normal,
+                    out: n,
+                }),
+                true,
+            );
+            Ok(Some(n))
         } else {
             Ok(None)
         }

@@ -13,6 +13,11 @@ pub enum BumpOp {
         axis: u8,
     },
     Leave,
+    /// From here on the shading normal `N` is the unit vector in slot `n` (Cycles' Set Normal,
+    /// after a displacement rendered as bump).
+    SetNormal {
+        n: Slot,
+    },
     Normal {
         strength: Slot,
         distance: Slot,
@@ -51,25 +56,40 @@ impl BumpOp {
             let v = safe_normalize(s.v(n));
             if v == Vec3::ZERO { g.n } else { v }
         });
-        let (dpdx, dpdy) = g.bump_axes();
-        let rx = dpdy.cross(n_in);
-        let ry = n_in.cross(dpdx);
-        let (hc, hx, hy) = (s.f(h[0]), s.f(h[1]), s.f(h[2]));
-        let det = dpdx.dot(rx);
-        let surfgrad = (hx - hc) * rx + (hy - hc) * ry;
         let mut dist = s.f(distance);
         if invert {
             dist = -dist;
         }
-        let k = s.f(strength).max(0.0);
-        let n = safe_normalize(det.abs() * n_in - dist * det.signum() * surfgrad);
-        let n = if n == Vec3::ZERO || !n.is_finite() {
-            n_in
-        } else {
-            safe_normalize(k * n + (1.0 - k) * n_in)
-        };
-        s.set_v(out, if n == Vec3::ZERO { n_in } else { n });
+        let h = [s.f(h[0]), s.f(h[1]), s.f(h[2])];
+        s.set_v(out, bumped_normal(g, n_in, h, dist, s.f(strength)));
     }
+}
+
+/// Cycles' bump formula: the unit normal `n_in` tilted by the surface gradient of the heights
+/// `h` at the point and at its two offsets along [`ShaderGlobals::bump_axes`], scaled by
+/// `distance`, blended with `n_in` by `strength` (clamped below at 0); `n_in` where it fails.
+#[inline]
+pub fn bumped_normal(
+    g: &ShaderGlobals,
+    n_in: Vec3,
+    h: [f32; 3],
+    distance: f32,
+    strength: f32,
+) -> Vec3 {
+    let (dpdx, dpdy) = g.bump_axes();
+    let rx = dpdy.cross(n_in);
+    let ry = n_in.cross(dpdx);
+    let [hc, hx, hy] = h;
+    let det = dpdx.dot(rx);
+    let surfgrad = (hx - hc) * rx + (hy - hc) * ry;
+    let k = strength.max(0.0);
+    let n = safe_normalize(det.abs() * n_in - distance * det.signum() * surfgrad);
+    let n = if n == Vec3::ZERO || !n.is_finite() {
+        n_in
+    } else {
+        safe_normalize(k * n + (1.0 - k) * n_in)
+    };
+    if n == Vec3::ZERO { n_in } else { n }
 }
 
 pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {

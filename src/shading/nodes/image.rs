@@ -1,5 +1,6 @@
-//! The Image Texture node: bilinear (Cycles' "Linear", no mipmaps) or closest lookups with
-//! Blender's extension modes and colour spaces.
+//! The Image Texture node: closest, bilinear (Cycles' "Linear", no mipmaps) or cubic B-spline
+//! ("Cubic", "Smart") lookups with Blender's extension modes and colour spaces, and its flat,
+//! box, sphere and tube projections.
 //!
 //! Alpha as Cycles has it: colour images (not Non-Color) whose alpha mode is Straight or
 //! Premultiplied are held with associated (premultiplied) alpha — 8-bit ones premultiplied in
@@ -9,7 +10,7 @@
 
 use crate::scene::{Image, Texture, Wrap};
 use crate::shading::compile::{CompileError, NodeCx, SocketType};
-use crate::shading::globals::ShadeEnv;
+use crate::shading::globals::{ShadeEnv, ShaderGlobals};
 use crate::shading::program::{Op, Slot, Slots};
 use crate::texture;
 use glam::{Vec2, Vec3, Vec4};
@@ -32,31 +33,151 @@ pub struct ImageOp {
     associate: bool,
     /// The Alpha output is used: the filtered colour is un-premultiplied.
     unassociate: bool,
+    /// Cubic B-spline filtering (Cycles' Cubic and Smart).
+    cubic: bool,
+    projection: Projection,
     vector: Slot,
     color: Slot,
     alpha: Slot,
 }
 
+/// How the Vector input becomes image coordinates (Cycles' `svm_node_tex_image_mapping` and
+/// `svm_node_tex_image_box`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// `(x, y)`.
+    Flat,
+    /// Three flat lookups along the object-space axes, weighted by the object-space normal,
+    /// blended over `blend` around the cube's edges.
+    Box { blend: f32 },
+    /// Longitude and latitude about the object's Z axis of `2 (co - 0.5)`.
+    Sphere,
+    /// Angle about Z and height of `2 (co - 0.5)`.
+    Tube,
+}
+
+/// Cycles' box-projection weights of the three axis lookups for the unit object-space normal
+/// `n` (barycentric in the triangle of the cube's three faces; single, double or triple mixes).
+fn box_weights(n: Vec3, blend: f32) -> Vec3 {
+    let a = n.abs();
+    let sum = a.x + a.y + a.z;
+    if !(sum > 0.0) {
+        return Vec3::X;
+    }
+    let n = a / sum;
+    let limit = 0.5 * (1.0 + blend);
+    let mut w = Vec3::ZERO;
+    if n.x > limit * (n.x + n.y) && n.x > limit * (n.x + n.z) {
+        w.x = 1.0;
+    } else if n.y > limit * (n.x + n.y) && n.y > limit * (n.y + n.z) {
+        w.y = 1.0;
+    } else if n.z > limit * (n.x + n.z) && n.z > limit * (n.y + n.z) {
+        w.z = 1.0;
+    } else if blend > 0.0 {
+        let ramp = |x: f32| ((x - 0.5 * (1.0 - blend)) / blend).clamp(0.0, 1.0);
+        if n.z < (1.0 - limit) * (n.y + n.x) {
+            w.x = ramp(n.x / (n.x + n.y));
+            w.y = 1.0 - w.x;
+        } else if n.x < (1.0 - limit) * (n.y + n.z) {
+            w.y = ramp(n.y / (n.y + n.z));
+            w.z = 1.0 - w.y;
+        } else if n.y < (1.0 - limit) * (n.x + n.z) {
+            w.x = ramp(n.x / (n.x + n.z));
+            w.z = 1.0 - w.x;
+        } else {
+            let k = |x: f32| ((2.0 - limit) * x + (limit - 1.0)) / (2.0 * limit - 1.0);
+            w = Vec3::new(k(n.x), k(n.y), k(n.z));
+        }
+    } else {
+        w.x = 1.0;
+    }
+    w
+}
+
+/// Cycles' `map_to_sphere` of a point (u from the angle about Z, v from the polar angle).
+fn map_to_sphere(co: Vec3) -> Vec2 {
+    let l = co.length_squared();
+    if !(l > 0.0) {
+        return Vec2::ZERO;
+    }
+    let u = if co.x == 0.0 && co.y == 0.0 {
+        0.0
+    } else {
+        0.5 - co.x.atan2(co.y) * 0.5 * std::f32::consts::FRAC_1_PI
+    };
+    let v = 1.0 - (co.z / l.sqrt()).clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI;
+    Vec2::new(u, v)
+}
+
+/// Cycles' `map_to_tube`.
+fn map_to_tube(co: Vec3) -> Vec2 {
+    if !(co.x * co.x + co.y * co.y > 0.0) {
+        return Vec2::ZERO;
+    }
+    let u = (1.0 - co.x.atan2(co.y) * std::f32::consts::FRAC_1_PI) * 0.5;
+    Vec2::new(u, (co.z + 1.0) * 0.5)
+}
+
 impl ImageOp {
     #[inline]
-    pub fn eval(&self, s: &mut Slots, env: &ShadeEnv) {
-        let v = s.v(self.vector);
-        let uv = if self.gltf_uv {
-            Vec2::new(v.x, v.y)
-        } else {
-            Vec2::new(v.x, 1.0 - v.y)
-        };
+    pub fn eval(&self, s: &mut Slots, g: &ShaderGlobals, env: &ShadeEnv) {
         let Some(img) = env.images.get(self.image) else {
             s.set_v(self.color, Vec3::new(1.0, 0.0, 1.0));
             s.set_f(self.alpha, 1.0);
             return;
         };
+        let co = s.v(self.vector);
+        let c = match self.projection {
+            Projection::Flat => self.at(img, Vec2::new(co.x, co.y)),
+            Projection::Sphere => self.at(img, map_to_sphere((co - 0.5) * 2.0)),
+            Projection::Tube => self.at(img, map_to_tube((co - 0.5) * 2.0)),
+            Projection::Box { blend } => {
+                let n = g.normal_to_object(g.n);
+                let w = box_weights(n, blend);
+                // Mapped so that no face's image is mirrored (Cycles' choice).
+                let mut c = Vec4::ZERO;
+                if w.x > 0.0 {
+                    let u = if n.x < 0.0 { 1.0 - co.y } else { co.y };
+                    c += w.x * self.at(img, Vec2::new(u, co.z));
+                }
+                if w.y > 0.0 {
+                    let u = if n.y > 0.0 { 1.0 - co.x } else { co.x };
+                    c += w.y * self.at(img, Vec2::new(u, co.z));
+                }
+                if w.z > 0.0 {
+                    let u = if n.z > 0.0 { 1.0 - co.y } else { co.y };
+                    c += w.z * self.at(img, Vec2::new(u, co.x));
+                }
+                c
+            }
+        };
+        s.set_v(self.color, c.truncate());
+        s.set_f(self.alpha, c.w);
+    }
+
+    /// One lookup at image coordinates `uv` (Blender's, or glTF's for glTF graphs): linear
+    /// colour and alpha.
+    #[inline]
+    fn at(&self, img: &Image, uv: Vec2) -> Vec4 {
+        let uv = if self.gltf_uv {
+            uv
+        } else {
+            Vec2::new(uv.x, 1.0 - uv.y)
+        };
         let byte = img.float.is_empty();
-        let c = if !self.associate && !self.clip {
+        if !self.associate && !self.clip && !self.cubic {
             texture::lookup(&self.sampler, img, uv, self.srgb)
         } else {
             let premultiply = self.associate && byte;
-            let mut c = lookup(&self.sampler, img, uv, premultiply, self.clip, self.srgb);
+            let mut c = lookup(
+                &self.sampler,
+                img,
+                uv,
+                premultiply,
+                self.clip,
+                self.srgb,
+                self.cubic,
+            );
             if self.unassociate && c.w != 0.0 && c.w != 1.0 {
                 c = (c.truncate() / c.w).extend(c.w);
             }
@@ -64,9 +185,7 @@ impl ImageOp {
                 c = texture::decode(c, true);
             }
             c
-        };
-        s.set_v(self.color, c.truncate());
-        s.set_f(self.alpha, c.w);
+        }
     }
 }
 
@@ -93,19 +212,32 @@ fn texel(img: &Image, x: usize, y: usize, premultiply: bool, srgb: bool) -> Vec4
 /// closest or bilinear, with texels premultiplied when `premultiply`; with `clip` (Blender's
 /// CLIP), texels outside the image are transparent black, so bilinear lookups fade out over
 /// the half texel around the border.
-fn lookup(tex: &Texture, img: &Image, uv: Vec2, premultiply: bool, clip: bool, srgb: bool) -> Vec4 {
+fn lookup(
+    tex: &Texture,
+    img: &Image,
+    uv: Vec2,
+    premultiply: bool,
+    clip: bool,
+    srgb: bool,
+    cubic: bool,
+) -> Vec4 {
     let (w, h) = (img.width, img.height);
     if w == 0 || h == 0 || (img.rgba8.is_empty() && img.float.is_empty()) || !uv.is_finite() {
         return Vec4::ONE;
     }
-    texture::filter(w, h, tex.nearest, uv, |x, y| {
+    let fetch = |x: i64, y: i64| {
         if clip && (x < 0 || y < 0 || x >= w as i64 || y >= h as i64) {
             return Vec4::ZERO;
         }
         let xi = texture::wrap(x, w, tex.wrap_s);
         let yi = texture::wrap(y, h, tex.wrap_t);
         texel(img, xi, yi, premultiply, srgb)
-    })
+    };
+    if cubic && !tex.nearest {
+        texture::filter_cubic(w, h, uv, fetch)
+    } else {
+        texture::filter(w, h, tex.nearest, uv, fetch)
+    }
 }
 
 /// Colour spaces Cycles treats as data (no colour conversion, no alpha association).
@@ -161,12 +293,14 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         _ => (wrap, wrap),
     };
     let interp = cx.prop_str("interpolation").unwrap_or("Linear");
-    if matches!(interp, "Cubic" | "Smart") {
-        cx.warn("cubic interpolation renders as linear");
-    }
-    if cx.prop_str("projection").is_some_and(|p| p != "FLAT") {
-        cx.warn("box/sphere/tube projection renders as flat");
-    }
+    let projection = match cx.prop_str("projection").unwrap_or("FLAT") {
+        "BOX" => Projection::Box {
+            blend: cx.prop_f32("projection_blend", 0.0).clamp(0.0, 1.0),
+        },
+        "SPHERE" => Projection::Sphere,
+        "TUBE" => Projection::Tube,
+        _ => Projection::Flat,
+    };
     let cs = cx.prop_str("colorspace").unwrap_or("sRGB");
     let srgb = match cs {
         "sRGB" => true,
@@ -200,6 +334,8 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             gltf_uv,
             associate,
             unassociate,
+            cubic: matches!(interp, "Cubic" | "Smart"),
+            projection,
             vector,
             color,
             alpha,
@@ -256,12 +392,12 @@ mod tests {
         let t = tex(Wrap::ClampToEdge, false);
         // Texel centres at u = 0.25 and 0.75; at u = 0 the left texel is blended half with
         // the transparent outside, at u = -0.25 (a whole half texel out) nothing is left.
-        let edge = lookup(&t, &img, Vec2::new(0.0, 0.5), false, true, false);
+        let edge = lookup(&t, &img, Vec2::new(0.0, 0.5), false, true, false, false);
         assert!((edge - Vec4::new(0.5, 101.0 / 510.0, 0.0, 64.0 / 255.0)).length() < 1e-6);
-        let out = lookup(&t, &img, Vec2::new(-0.25, 0.5), false, true, false);
+        let out = lookup(&t, &img, Vec2::new(-0.25, 0.5), false, true, false, false);
         assert_eq!(out, Vec4::ZERO);
         // EXTEND holds the edge texel instead.
-        let ext = lookup(&t, &img, Vec2::new(0.0, 0.5), false, false, false);
+        let ext = lookup(&t, &img, Vec2::new(0.0, 0.5), false, false, false, false);
         assert!((ext - Vec4::new(1.0, 101.0 / 255.0, 0.0, 128.0 / 255.0)).length() < 1e-6);
     }
 
@@ -269,9 +405,9 @@ mod tests {
     fn closest_clip_is_black_outside_only() {
         let img = image();
         let t = tex(Wrap::ClampToEdge, true);
-        let inside = lookup(&t, &img, Vec2::new(0.99, 0.5), false, true, false);
+        let inside = lookup(&t, &img, Vec2::new(0.99, 0.5), false, true, false, false);
         assert_eq!(inside, Vec4::new(0.0, 0.0, 200.0 / 255.0, 1.0));
-        let outside = lookup(&t, &img, Vec2::new(1.01, 0.5), false, true, false);
+        let outside = lookup(&t, &img, Vec2::new(1.01, 0.5), false, true, false, false);
         assert_eq!(outside, Vec4::ZERO);
     }
 }

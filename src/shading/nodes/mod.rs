@@ -5,6 +5,7 @@ pub mod bump;
 pub mod color;
 pub mod convert;
 pub mod curves;
+pub mod displacement;
 pub mod environment;
 pub mod image;
 pub mod input;
@@ -28,6 +29,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         utility::compile,
         vector::compile,
         bump::compile,
+        displacement::compile,
         convert::compile,
         environment::compile,
     ] {
