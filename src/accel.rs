@@ -96,6 +96,21 @@ fn intersect_triangle(
 }
 
 impl Accel {
+    /// Makes the triangles whose key is `[mesh, _]` unhittable in place (zero edges: the
+    /// determinant of every ray against them is 0), without building the BVH again; its
+    /// boxes still enclose them, which costs traversal only. Returns how many there were.
+    pub fn remove_mesh(&mut self, mesh: u32) -> usize {
+        let mut n = 0;
+        for (t, k) in self.tris.iter_mut().zip(&self.keys) {
+            if k[0] == mesh {
+                t.e1 = Vec3A::ZERO;
+                t.e2 = Vec3A::ZERO;
+                n += 1;
+            }
+        }
+        n
+    }
+
     /// Builds the BVH over `triangles` (world-space vertex triples); triangle `i` has the
     /// key `[0, i]`.
     pub fn build(triangles: &[[Vec3; 3]]) -> Accel {

@@ -36,6 +36,8 @@ pub struct InstanceAccel {
     /// In the top-level BVH's leaf order.
     placements: Vec<Placement>,
     blas: Vec<Accel>,
+    /// The mesh each bottom level was built from.
+    blas_mesh: Vec<usize>,
 }
 
 impl InstanceAccel {
@@ -43,6 +45,33 @@ impl InstanceAccel {
     /// instance is kept. Instances that cannot be drawn (a missing mesh or material, a
     /// singular or non-finite transform) are left out. Bottom-level hits carry the key `[mesh index, triangle index]`.
     pub fn new(scene: &Scene, keep: impl Fn(usize) -> bool) -> Option<InstanceAccel> {
+        Self::reusing(scene, keep, None, &[])
+    }
+
+    /// [`InstanceAccel::new`] taking the bottom levels of `old` for the meshes it has, except
+    /// those `changed` lists (their triangles are new): after instances moved or a mesh was
+    /// replaced, only the top level and the new meshes' levels are built.
+    pub fn rebuilt(
+        scene: &Scene,
+        old: Option<InstanceAccel>,
+        changed: &[usize],
+    ) -> Option<InstanceAccel> {
+        Self::reusing(scene, |_| true, old, changed)
+    }
+
+    fn reusing(
+        scene: &Scene,
+        keep: impl Fn(usize) -> bool,
+        old: Option<InstanceAccel>,
+        changed: &[usize],
+    ) -> Option<InstanceAccel> {
+        let mut reuse: std::collections::HashMap<usize, Accel> = old
+            .map(|o| o.blas_mesh.into_iter().zip(o.blas).collect())
+            .unwrap_or_default();
+        for m in changed {
+            reuse.remove(m);
+        }
+        let mut blas_mesh = Vec::new();
         let mut blas_of = vec![u32::MAX; scene.meshes.len()];
         let mut blas = Vec::new();
         let mut bounds = Vec::new();
@@ -64,10 +93,13 @@ impl InstanceAccel {
             };
             if blas_of[inst.mesh] == u32::MAX {
                 blas_of[inst.mesh] = blas.len() as u32;
+                blas_mesh.push(inst.mesh);
                 let mi = inst.mesh as u32;
-                let tris = (mesh.indices.iter()).map(|t| t.map(|i| mesh.positions[i as usize]));
-                let keys = (0..mesh.indices.len() as u32).map(|ti| [mi, ti]);
-                blas.push(Accel::build_from(mesh.indices.len(), tris, keys));
+                blas.push(reuse.remove(&inst.mesh).unwrap_or_else(|| {
+                    let tris = (mesh.indices.iter()).map(|t| t.map(|i| mesh.positions[i as usize]));
+                    let keys = (0..mesh.indices.len() as u32).map(|ti| [mi, ti]);
+                    Accel::build_from(mesh.indices.len(), tris, keys)
+                }));
             }
             let (lo, hi) = crate::scene::instance::transform_bounds(&inst.to_world, lo, hi);
             if !(lo.is_finite() && hi.is_finite()) {
@@ -100,6 +132,7 @@ impl InstanceAccel {
             tlas,
             placements,
             blas,
+            blas_mesh,
         })
     }
 

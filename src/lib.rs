@@ -20,6 +20,7 @@ pub mod render_scene;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod session;
 pub mod shading;
 pub mod study;
 pub mod texture;

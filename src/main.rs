@@ -49,6 +49,17 @@ enum Command {
     /// Measure the integrators: relMSE, bias and time against converged references, a
     /// light-size sweep, plots and a report (docs/study.md shows a run).
     Study(StudyArgs),
+    /// A long-lived renderer for Blender's interactive viewport: commands on stdin, progressive
+    /// images on stdout (docs/session.md). Exits 0 when stdin ends.
+    Session {
+        /// Worker threads (0 = one per core).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// The Open Image Denoise library (libOpenImageDenoise.so or its folder), for the
+        /// viewport denoiser.
+        #[arg(long, value_name = "PATH")]
+        oidn_lib: Option<PathBuf>,
+    },
     /// Merge the accumulators of sample-range parts (`render --sample-range A:B
     /// --accumulators PART.exr`) into the image of the whole render.
     Merge(MergeArgs),
@@ -1088,6 +1099,21 @@ fn run_info(path: &Path) -> ExitCode {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     install_signal_handlers();
+    if let Command::Session { threads, oidn_lib } = &cli.command {
+        if *threads > render::MAX_THREADS {
+            eprintln!(
+                "tesela: error: --threads {threads} is too many (at most {})",
+                render::MAX_THREADS
+            );
+            return ExitCode::from(EXIT_USAGE);
+        }
+        let opts = tesela::session::SessionOptions {
+            threads: *threads,
+            oidn_lib: oidn_lib.clone(),
+        };
+        let code = tesela::session::run(&opts, std::io::stdin(), std::io::stdout(), &CANCEL);
+        return ExitCode::from(code as u8);
+    }
     spawn_cancel_watchdog();
     match cli.command {
         Command::Render(args) => {
@@ -1098,6 +1124,7 @@ fn main() -> ExitCode {
             }
         }
         Command::Info { scene } => run_info(&scene),
+        Command::Session { .. } => ExitCode::SUCCESS,
         Command::Study(args) => run_study(&args),
         Command::Merge(args) => run_merge(&args),
         Command::ExportBuiltin { name, out } => match scene::builtin::by_name(&name) {

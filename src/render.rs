@@ -495,7 +495,7 @@ impl TileState {
 
 /// Renders the image. `on_tile(tile, tiles_done, tiles_total)` runs on a worker thread as each
 /// tile finishes a sample round (at most about once a second per tile when there are several
-/// rounds, and always for the last). `cancel` is polled between rows.
+/// rounds, and always for the last). `cancel` is polled between pixels.
 pub fn render(
     scene: &RenderScene,
     opts: &RenderOptions,
@@ -558,96 +558,140 @@ pub fn unsplittable(opts: &RenderOptions) -> Option<&'static str> {
     }
 }
 
-/// Renders samples `range` of every pixel into the film's sums (rounds, adaptive sampling
-/// and the time limit only for a whole render, `0..opts.spp`).
-fn render_film(
-    scene: &RenderScene,
-    opts: &RenderOptions,
+/// A film whose per-pixel sums persist between sample rounds. [`render_film`] runs its
+/// rounds through one; the interactive session adds rounds as it goes. A pixel sums its
+/// samples in sample order whatever the split into rounds, so the image at `N` samples is
+/// the same bits however the rounds (and the threads) divided the work.
+pub struct Progressive {
+    prepared: Prepared,
+    opts: RenderOptions,
     sampling: Sampling,
-    range: Range<u32>,
-    cancel: &AtomicBool,
-    on_tile: &(dyn Fn(&Tile, usize, usize) + Sync),
-) -> Result<(Accumulators, RenderStats), RenderError> {
-    let Prepared {
-        integrator,
-        camera,
-        region: [rx, ry, rw, rh],
-    } = prepare(scene, opts)?;
-    let ts = opts.tile_size.max(1);
-    // The film's sums: the passes asked for and the Color passes their light passes need.
-    let acc_passes = opts.passes.with_dividers();
-    let acc_stride = acc_passes.stride();
-    let mut tiles = Vec::new();
-    for ty in (0..rh).step_by(ts as usize) {
-        for tx in (0..rw).step_by(ts as usize) {
-            let (tw, th) = (ts.min(rw - tx), ts.min(rh - ty));
-            let n = (tw * th) as usize;
-            tiles.push(TileState {
-                x: tx,
-                y: ty,
-                w: tw,
-                h: th,
-                px: vec![
-                    PixelAcc {
-                        next: range.start,
-                        ..Default::default()
-                    };
-                    n
-                ],
-                aov: vec![0.0; n * acc_stride],
-                rays: 0,
-                rejected: 0,
-            });
-        }
-    }
-    let data_ctx = (!acc_passes.is_empty()).then_some(DataContext {
-        scene,
-        camera: &camera,
-        passes: &acc_passes,
-        mist: scene.scene.settings.mist,
-    });
-    let transparent = scene.scene.settings.film_transparent;
-    let time_limit = opts.time_limit.filter(|t| *t > 0.0);
-    let whole = range == (0..opts.spp);
-    let ends = if whole {
-        crate::film::round_ends(opts.spp, opts.adaptive.as_ref(), time_limit.is_some())
-    } else {
-        vec![range.end]
-    };
-    let threshold = opts.adaptive.map(|a| a.resolved(opts.spp).0);
-    let total = tiles.len() * ends.len();
-    let done = AtomicUsize::new(0);
-    let start = Instant::now();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.threads)
-        .build()
-        .map_err(|e| RenderError::Invalid(format!("cannot start worker threads: {e}")))?;
+    /// The film's sums: the passes asked for and the Color passes their light passes need.
+    acc_passes: PassSet,
+    tiles: Vec<TileState>,
+    /// The first sample of every pixel.
+    first: u32,
+    rounds: u32,
+    /// Blender's film_transparent: alpha is the coverage.
+    transparent: bool,
+}
 
-    let mut last_stream: Option<Instant> = None;
-    let mut streamed_last = false;
-    let mut rounds = 0;
-    for (ri, &end) in ends.iter().enumerate() {
-        let last = ri + 1 == ends.len();
-        let stream = last || last_stream.is_none_or(|t| t.elapsed().as_secs_f64() >= 1.0);
+impl Progressive {
+    /// An empty film for `opts` (its `spp` is only checked, never used: rounds say how far).
+    pub fn new(
+        scene: &RenderScene,
+        opts: &RenderOptions,
+        sampling: Sampling,
+    ) -> Result<Progressive, RenderError> {
+        Self::starting_at(scene, opts, sampling, 0)
+    }
+
+    /// [`Progressive::new`] whose pixels start at sample `first`.
+    fn starting_at(
+        scene: &RenderScene,
+        opts: &RenderOptions,
+        sampling: Sampling,
+        first: u32,
+    ) -> Result<Progressive, RenderError> {
+        let prepared = prepare(scene, opts)?;
+        let [_, _, rw, rh] = prepared.region;
+        let ts = opts.tile_size.max(1);
+        let acc_passes = opts.passes.with_dividers();
+        let acc_stride = acc_passes.stride();
+        let mut tiles = Vec::new();
+        for ty in (0..rh).step_by(ts as usize) {
+            for tx in (0..rw).step_by(ts as usize) {
+                let (tw, th) = (ts.min(rw - tx), ts.min(rh - ty));
+                let n = (tw * th) as usize;
+                tiles.push(TileState {
+                    x: tx,
+                    y: ty,
+                    w: tw,
+                    h: th,
+                    px: vec![
+                        PixelAcc {
+                            next: first,
+                            ..Default::default()
+                        };
+                        n
+                    ],
+                    aov: vec![0.0; n * acc_stride],
+                    rays: 0,
+                    rejected: 0,
+                });
+            }
+        }
+        Ok(Progressive {
+            prepared,
+            opts: opts.clone(),
+            sampling,
+            acc_passes,
+            tiles,
+            first,
+            rounds: 0,
+            transparent: scene.scene.settings.film_transparent,
+        })
+    }
+
+    /// Renders every pixel's samples up to `end` (those not yet rendered, of pixels adaptive
+    /// sampling has not stopped) on `pool`. `cancel` is polled before each pixel; a cancelled
+    /// round leaves each pixel with whole samples only, so a later round resumes it.
+    pub fn round(
+        &mut self,
+        scene: &RenderScene,
+        end: u32,
+        pool: &rayon::ThreadPool,
+        cancel: &AtomicBool,
+    ) -> Result<(), RenderError> {
+        self.round_with(scene, end, pool, cancel, &|_, _| {})
+    }
+
+    /// [`Progressive::round`], calling `after(tile, worked)` on the worker as each tile is done
+    /// (`worked`: the tile rendered samples in this round).
+    fn round_with(
+        &mut self,
+        scene: &RenderScene,
+        end: u32,
+        pool: &rayon::ThreadPool,
+        cancel: &AtomicBool,
+        after: &(dyn Fn(&TileState, bool) + Sync),
+    ) -> Result<(), RenderError> {
+        let Prepared {
+            integrator,
+            camera,
+            region: [rx, ry, _, _],
+        } = &self.prepared;
+        let (opts, sampling) = (&self.opts, self.sampling);
+        let acc_stride = self.acc_passes.stride();
+        let data_ctx = (!self.acc_passes.is_empty()).then_some(DataContext {
+            scene,
+            camera,
+            passes: &self.acc_passes,
+            mist: scene.scene.settings.mist,
+        });
         let result: Result<(), RenderError> = pool.install(|| {
-            tiles.par_iter_mut().try_for_each(|t| {
+            self.tiles.par_iter_mut().try_for_each(|t| {
                 let mut ctx = Ctx::new(SobolSampler::new(0, 0, 0));
                 let mut rej = 0u64;
                 let mut worked = false;
                 for y in 0..t.h {
-                    if cancel.load(Ordering::Relaxed) {
-                        return Err(RenderError::Cancelled);
-                    }
                     for x in 0..t.w {
                         let i = (y * t.w + x) as usize;
                         let acc = &mut t.px[i];
                         if acc.converged || acc.next >= end {
                             continue;
                         }
+                        // Polled per pixel: a pixel's samples are the longest wait (a row of
+                        // a tile at 16 samples in a million-triangle scene is ~20 ms).
+                        if cancel.load(Ordering::Relaxed) {
+                            t.rays += ctx.rays;
+                            t.rejected += rej;
+                            return Err(RenderError::Cancelled);
+                        }
                         worked = true;
                         render_samples(
                             scene,
-                            &camera,
+                            camera,
                             integrator.as_ref(),
                             opts,
                             data_ctx.as_ref(),
@@ -663,87 +707,77 @@ fn render_film(
                 }
                 t.rays += ctx.rays;
                 t.rejected += rej;
-                let n = done.fetch_add(1, Ordering::Relaxed) + 1;
-                if stream && (worked || last) {
-                    on_tile(
-                        &t.snapshot(&opts.passes, &acc_passes, transparent, end),
-                        n,
-                        total,
-                    );
-                }
+                after(t, worked);
                 Ok(())
             })
         });
         result?;
-        rounds += 1;
-        if stream {
-            last_stream = Some(Instant::now());
-        }
-        streamed_last = stream;
-        if last {
-            break;
-        }
-        let mut all_converged = false;
-        if let Some(threshold) = threshold {
-            all_converged = check_convergence(&mut tiles, rw, rh, threshold);
-        }
-        let out_of_time = time_limit.is_some_and(|t| start.elapsed().as_secs_f64() >= t);
-        if all_converged || out_of_time {
-            break;
-        }
-    }
-    if !streamed_last {
-        // The render stopped early after a round that was not streamed: send the final film.
-        let n = tiles.len();
-        for (i, t) in tiles.iter().enumerate() {
-            let spp = t.px.iter().map(|p| p.next).max().unwrap_or(0);
-            on_tile(
-                &t.snapshot(&opts.passes, &acc_passes, transparent, spp),
-                total - n + i + 1,
-                total,
-            );
-        }
+        self.rounds += 1;
+        Ok(())
     }
 
-    let mut film = Accumulators {
-        width: rw,
-        height: rh,
-        samples: range.clone(),
-        spp: opts.spp,
-        passes: acc_passes.clone(),
-        transparent,
-        key: String::new(),
-        pixels: vec![PixelAcc::default(); rw as usize * rh as usize],
-        aovs: vec![0.0; rw as usize * rh as usize * acc_stride],
-    };
-    let first = range.start;
-    let (mut rays, mut rejected, mut samples) = (0u64, 0u64, 0u64);
-    let (mut spp_min, mut spp_max, mut noise) = (u32::MAX, 0u32, 0.0f64);
-    for t in &tiles {
-        for y in 0..t.h {
-            let src = (y * t.w) as usize..((y + 1) * t.w) as usize;
-            let row = (t.y + y) as usize * rw as usize + t.x as usize;
-            film.pixels[row..row + t.w as usize].copy_from_slice(&t.px[src.clone()]);
-            film.aovs[row * acc_stride..(row + t.w as usize) * acc_stride]
-                .copy_from_slice(&t.aov[src.start * acc_stride..src.end * acc_stride]);
-        }
-        for p in &t.px {
-            let n = p.next - first;
-            samples += n as u64;
-            spp_min = spp_min.min(n);
-            spp_max = spp_max.max(n);
-            let e = p.error() as f64;
-            if e.is_finite() {
-                noise += e;
+    /// Samples per pixel every pixel has reached.
+    pub fn samples(&self) -> u32 {
+        (self.tiles.iter())
+            .flat_map(|t| t.px.iter().map(|p| p.next))
+            .min()
+            .unwrap_or(0)
+    }
+
+    /// The film's sums as they stand, for samples `first..end` of a render of `spp`.
+    fn accumulators(&self, end: u32) -> Accumulators {
+        let [_, _, rw, rh] = self.prepared.region;
+        let acc_stride = self.acc_passes.stride();
+        let mut film = Accumulators {
+            width: rw,
+            height: rh,
+            samples: self.first..end,
+            spp: self.opts.spp,
+            passes: self.acc_passes.clone(),
+            transparent: self.transparent,
+            key: String::new(),
+            pixels: vec![PixelAcc::default(); rw as usize * rh as usize],
+            aovs: vec![0.0; rw as usize * rh as usize * acc_stride],
+        };
+        for t in &self.tiles {
+            for y in 0..t.h {
+                let src = (y * t.w) as usize..((y + 1) * t.w) as usize;
+                let row = (t.y + y) as usize * rw as usize + t.x as usize;
+                film.pixels[row..row + t.w as usize].copy_from_slice(&t.px[src.clone()]);
+                film.aovs[row * acc_stride..(row + t.w as usize) * acc_stride]
+                    .copy_from_slice(&t.aov[src.start * acc_stride..src.end * acc_stride]);
             }
         }
-        rays += t.rays;
-        rejected += t.rejected;
+        film
     }
-    let pixels = (rw as u64 * rh as u64).max(1);
-    let seconds = start.elapsed().as_secs_f64();
-    Ok((
-        film,
+
+    /// The film as it stands: the window's pixels and the passes asked for.
+    pub fn image(&self) -> Image {
+        let mut image = self.accumulators(self.samples()).resolve();
+        image.retain_passes(&self.opts.passes);
+        image
+    }
+
+    /// The film's figures, `seconds` after the render started.
+    pub fn stats(&self, seconds: f64) -> RenderStats {
+        let [_, _, rw, rh] = self.prepared.region;
+        let (mut rays, mut rejected, mut samples) = (0u64, 0u64, 0u64);
+        let (mut spp_min, mut spp_max, mut noise) = (u32::MAX, 0u32, 0.0f64);
+        for t in &self.tiles {
+            for p in &t.px {
+                let n = p.next - self.first;
+                samples += n as u64;
+                spp_min = spp_min.min(n);
+                spp_max = spp_max.max(n);
+                let e = p.error() as f64;
+                if e.is_finite() {
+                    noise += e;
+                }
+            }
+            rays += t.rays;
+            rejected += t.rejected;
+        }
+        let pixels = (rw as u64 * rh as u64).max(1);
         RenderStats {
             seconds,
             samples,
@@ -756,9 +790,87 @@ fn render_film(
             spp_mean: samples as f64 / pixels as f64,
             // In units of the noise threshold the user sets (Cycles' internal one is 5x).
             noise: noise / pixels as f64 / 5.0,
-            rounds,
-        },
-    ))
+            rounds: self.rounds,
+        }
+    }
+}
+
+/// Renders samples `range` of every pixel into the film's sums (rounds, adaptive sampling
+/// and the time limit only for a whole render, `0..opts.spp`).
+fn render_film(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    sampling: Sampling,
+    range: Range<u32>,
+    cancel: &AtomicBool,
+    on_tile: &(dyn Fn(&Tile, usize, usize) + Sync),
+) -> Result<(Accumulators, RenderStats), RenderError> {
+    let mut film = Progressive::starting_at(scene, opts, sampling, range.start)?;
+    let [_, _, rw, rh] = film.prepared.region;
+    let acc_passes = film.acc_passes.clone();
+    let transparent = film.transparent;
+    let time_limit = opts.time_limit.filter(|t| *t > 0.0);
+    let whole = range == (0..opts.spp);
+    let ends = if whole {
+        crate::film::round_ends(opts.spp, opts.adaptive.as_ref(), time_limit.is_some())
+    } else {
+        vec![range.end]
+    };
+    let threshold = opts.adaptive.map(|a| a.resolved(opts.spp).0);
+    let total = film.tiles.len() * ends.len();
+    let done = AtomicUsize::new(0);
+    let start = Instant::now();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads)
+        .build()
+        .map_err(|e| RenderError::Invalid(format!("cannot start worker threads: {e}")))?;
+
+    let mut last_stream: Option<Instant> = None;
+    let mut streamed_last = false;
+    for (ri, &end) in ends.iter().enumerate() {
+        let last = ri + 1 == ends.len();
+        let stream = last || last_stream.is_none_or(|t| t.elapsed().as_secs_f64() >= 1.0);
+        let after = |t: &TileState, worked: bool| {
+            let n = done.fetch_add(1, Ordering::Relaxed) + 1;
+            if stream && (worked || last) {
+                on_tile(
+                    &t.snapshot(&opts.passes, &acc_passes, transparent, end),
+                    n,
+                    total,
+                );
+            }
+        };
+        film.round_with(scene, end, &pool, cancel, &after)?;
+        if stream {
+            last_stream = Some(Instant::now());
+        }
+        streamed_last = stream;
+        if last {
+            break;
+        }
+        let mut all_converged = false;
+        if let Some(threshold) = threshold {
+            all_converged = check_convergence(&mut film.tiles, rw, rh, threshold);
+        }
+        let out_of_time = time_limit.is_some_and(|t| start.elapsed().as_secs_f64() >= t);
+        if all_converged || out_of_time {
+            break;
+        }
+    }
+    if !streamed_last {
+        // The render stopped early after a round that was not streamed: send the final film.
+        let n = film.tiles.len();
+        for (i, t) in film.tiles.iter().enumerate() {
+            let spp = t.px.iter().map(|p| p.next).max().unwrap_or(0);
+            on_tile(
+                &t.snapshot(&opts.passes, &acc_passes, transparent, spp),
+                total - n + i + 1,
+                total,
+            );
+        }
+    }
+    let stats = film.stats(start.elapsed().as_secs_f64());
+    Ok((film.accumulators(range.end), stats))
 }
 
 /// Adaptive sampling's check after a round: marks the pixels whose error is below

@@ -203,45 +203,66 @@ pub struct RenderScene {
     pub radius: f32,
     /// Number of triangles.
     triangles: usize,
+    /// How shadow rays choose a light (kept to rebuild the emitters).
+    choice: LightChoice,
 }
 
-impl RenderScene {
-    /// Builds the BVH and the emitters. Emissive meshes of zero area are skipped with a warning.
-    pub fn new(mut scene: Scene, choice: LightChoice) -> RenderScene {
-        let mut warnings = Vec::new();
-        let programs: Vec<Arc<Program>> = scene
-            .materials
-            .iter()
-            .map(|m| {
-                let c = crate::shading::material_program(m, &scene.textures);
-                for w in c.warnings {
-                    if !warnings.contains(&w) {
-                        warnings.push(w);
-                    }
+/// Each material's compiled program, and what the compiler reported (once each).
+fn compile_programs(scene: &Scene) -> (Vec<Arc<Program>>, Vec<String>) {
+    let mut warnings = Vec::new();
+    let programs = (scene.materials.iter())
+        .map(|m| {
+            let c = crate::shading::material_program(m, &scene.textures);
+            for w in c.warnings {
+                if !warnings.contains(&w) {
+                    warnings.push(w);
                 }
-                Arc::new(c.program)
-            })
-            .collect();
-        bake_emissive_instances(&mut scene, &programs);
-        // Triangles go straight from the meshes into the builder: no copy of the scene at the
-        // build's peak memory.
+            }
+            Arc::new(c.program)
+        })
+        .collect();
+    (programs, warnings)
+}
+
+/// The camera in Blender's coordinates (for the graph's Camera coordinates).
+fn blender_camera_to_world(scene: &Scene) -> Mat4 {
+    scene.camera.map_or(Mat4::IDENTITY, |c| {
+        let b = Mat4::from_cols(
+            glam::Vec4::X,
+            glam::Vec4::new(0.0, 0.0, 1.0, 0.0),
+            glam::Vec4::new(0.0, -1.0, 0.0, 0.0),
+            glam::Vec4::W,
+        );
+        b * c.to_world
+    })
+}
+
+/// The emitters of a scene and how rays and light choice find them: everything a change of
+/// a material, a light or the world rebuilds (the scene's BVH stays).
+struct LightParts {
+    emitter_accel: Option<Accel>,
+    emitters: Vec<EmitterInstance>,
+    mesh_emitter: Vec<Option<u32>>,
+    background: Option<u32>,
+    visibility: Vec<LightVisibility>,
+    light_shapes: Vec<u32>,
+    light_bvh: LightBvh,
+    suns: Vec<u32>,
+    lights: LightSampler,
+}
+
+impl LightParts {
+    /// The emitters of `scene` whose materials compiled to `programs`, for a scene of
+    /// `triangles` world-space triangles and bounding radius `radius`.
+    fn new(
+        scene: &Scene,
+        programs: &[Arc<Program>],
+        camera_to_world: Mat4,
+        (triangles, radius): (usize, f32),
+        choice: LightChoice,
+        warnings: &mut Vec<String>,
+    ) -> LightParts {
         let placed = scene.placed_meshes();
-        let (n, tris, keys) = mesh_triangles(&scene, |i| !placed[i]);
-        let accel = Accel::build_from(n, tris, keys);
-        let instances = InstanceAccel::new(&scene, |_| true);
-        let radius = match scene.bounds() {
-            Some((lo, hi)) => ((hi - lo) * 0.5).length().max(1e-3),
-            None => 1.0,
-        };
-        let camera_to_world = scene.camera.map_or(Mat4::IDENTITY, |c| {
-            let b = Mat4::from_cols(
-                glam::Vec4::X,
-                glam::Vec4::new(0.0, 0.0, 1.0, 0.0),
-                glam::Vec4::new(0.0, -1.0, 0.0, 0.0),
-                glam::Vec4::W,
-            );
-            b * c.to_world
-        });
         let mut emitters = Vec::new();
         let mut mesh_emitter = vec![None; scene.meshes.len()];
         for (mi, m) in scene.meshes.iter().enumerate() {
@@ -251,7 +272,7 @@ impl RenderScene {
             if placed[mi] || m.positions.is_empty() || !program.may_emit() {
                 continue;
             }
-            match AreaEmitter::with_program(&scene, mi, program.clone()) {
+            match AreaEmitter::with_program(scene, mi, program.clone()) {
                 Some(e) => {
                     mesh_emitter[mi] = Some(emitters.len() as u32);
                     emitters.push(EmitterInstance::Area(e.with_camera(camera_to_world)));
@@ -297,7 +318,7 @@ impl RenderScene {
         }
         let mut background = None;
         if let Some(world) =
-            crate::emitter::environment::world_emitter(&scene, camera_to_world, &mut warnings)
+            crate::emitter::environment::world_emitter(scene, camera_to_world, warnings)
         {
             background = Some(emitters.len() as u32);
             emitters.push(world);
@@ -322,10 +343,48 @@ impl RenderScene {
             }
         }
         let light_bvh = LightBvh::new(&bounds);
-        let emitter_accel = emitter_accel(&scene, &mesh_emitter, n);
-        let powers: Vec<f32> = emitters.iter().map(|e| e.power(&scene, radius)).collect();
-        let bounds: Vec<_> = emitters.iter().map(|e| light_bounds(&scene, e)).collect();
+        let emitter_accel = emitter_accel(scene, &mesh_emitter, triangles);
+        let powers: Vec<f32> = emitters.iter().map(|e| e.power(scene, radius)).collect();
+        let bounds: Vec<_> = emitters.iter().map(|e| light_bounds(scene, e)).collect();
         let lights = LightSampler::with_bounds(&powers, &bounds, choice);
+        LightParts {
+            emitter_accel,
+            emitters,
+            mesh_emitter,
+            background,
+            visibility,
+            light_shapes,
+            light_bvh,
+            suns,
+            lights,
+        }
+    }
+}
+
+impl RenderScene {
+    /// Builds the BVH and the emitters. Emissive meshes of zero area are skipped with a warning.
+    pub fn new(mut scene: Scene, choice: LightChoice) -> RenderScene {
+        let (programs, mut warnings) = compile_programs(&scene);
+        bake_emissive_instances(&mut scene, &programs);
+        // Triangles go straight from the meshes into the builder: no copy of the scene at the
+        // build's peak memory.
+        let placed = scene.placed_meshes();
+        let (n, tris, keys) = mesh_triangles(&scene, |i| !placed[i]);
+        let accel = Accel::build_from(n, tris, keys);
+        let instances = InstanceAccel::new(&scene, |_| true);
+        let radius = match scene.bounds() {
+            Some((lo, hi)) => ((hi - lo) * 0.5).length().max(1e-3),
+            None => 1.0,
+        };
+        let camera_to_world = blender_camera_to_world(&scene);
+        let parts = LightParts::new(
+            &scene,
+            &programs,
+            camera_to_world,
+            (n, radius),
+            choice,
+            &mut warnings,
+        );
         scene.warnings.extend(warnings);
         let passes = programs.iter().any(|p| p.may_pass());
         RenderScene {
@@ -335,17 +394,130 @@ impl RenderScene {
             camera_to_world,
             accel,
             instances,
-            emitter_accel,
+            emitter_accel: parts.emitter_accel,
             triangles: n,
-            emitters,
-            mesh_emitter,
-            background,
-            visibility,
-            light_shapes,
-            light_bvh,
-            suns,
-            lights,
+            emitters: parts.emitters,
+            mesh_emitter: parts.mesh_emitter,
+            background: parts.background,
+            visibility: parts.visibility,
+            light_shapes: parts.light_shapes,
+            light_bvh: parts.light_bvh,
+            suns: parts.suns,
+            lights: parts.lights,
             radius,
+            choice,
+        }
+    }
+
+    fn set_lights(&mut self, p: LightParts) {
+        self.emitter_accel = p.emitter_accel;
+        self.emitters = p.emitters;
+        self.mesh_emitter = p.mesh_emitter;
+        self.background = p.background;
+        self.visibility = p.visibility;
+        self.light_shapes = p.light_shapes;
+        self.light_bvh = p.light_bvh;
+        self.suns = p.suns;
+        self.lights = p.lights;
+    }
+
+    /// Whether [`RenderScene::refresh_shading`] can take the scene's materials as they stand
+    /// now: false when a material of an instance starts or stops emitting (instances that
+    /// emit are baked into world space: the BVH must be built again, by [`RenderScene::new`]).
+    pub fn shading_keeps_geometry(&self) -> bool {
+        let mut checked: std::collections::HashMap<usize, bool> = Default::default();
+        self.scene.instances.iter().all(|i| {
+            let Some(mesh) = self.scene.meshes.get(i.mesh) else {
+                return true;
+            };
+            let m = i.material.unwrap_or(mesh.material);
+            *checked.entry(m).or_insert_with(|| {
+                let old = self.programs.get(m).is_some_and(|p| p.may_emit());
+                let new = (self.scene.materials.get(m)).is_some_and(|mat| {
+                    crate::shading::material_program(mat, &self.scene.textures)
+                        .program
+                        .may_emit()
+                });
+                old == new
+            })
+        })
+    }
+
+    /// Compiles the materials again and rebuilds the emitters from the scene's materials,
+    /// lights and world as they stand (after an edit of `scene`); the BVH stays. Returns what
+    /// the compiler and the emitters reported.
+    pub fn refresh_shading(&mut self) -> Vec<String> {
+        let (programs, mut warnings) = compile_programs(&self.scene);
+        self.programs = programs;
+        self.passes = self.programs.iter().any(|p| p.may_pass());
+        let parts = LightParts::new(
+            &self.scene,
+            &self.programs,
+            self.camera_to_world,
+            (self.triangles, self.radius),
+            self.choice,
+            &mut warnings,
+        );
+        self.set_lights(parts);
+        warnings
+    }
+
+    /// Whether some instance's material may emit (such instances are baked into world space,
+    /// so moving one means building the world's BVH again).
+    pub fn instances_emit(&self) -> bool {
+        self.scene.instances.iter().any(|i| {
+            let m = (self.scene.meshes.get(i.mesh))
+                .map_or(0, |mesh| i.material.unwrap_or(mesh.material));
+            self.programs.get(m).is_none_or(|p| p.may_emit())
+        })
+    }
+
+    /// After `scene.instances` changed (moved, added, removed) and the meshes `changed` got new
+    /// triangles: builds the top level again (and the bottom levels of `changed`), the
+    /// scene's radius and the emitters; the world-space BVH stays. Needs
+    /// `!instances_emit()` before and after.
+    pub fn refresh_instances(&mut self, changed: &[usize]) -> Vec<String> {
+        self.instances = InstanceAccel::rebuilt(&self.scene, self.instances.take(), changed);
+        self.radius = match self.scene.bounds() {
+            Some((lo, hi)) => ((hi - lo) * 0.5).length().max(1e-3),
+            None => 1.0,
+        };
+        self.refresh_shading()
+    }
+
+    /// Takes world-space meshes out of the world's BVH without building it again (see
+    /// [`Accel::remove_mesh`]): for a mesh that instances place from now on.
+    pub fn remove_world_meshes(&mut self, meshes: &[usize]) {
+        for &m in meshes {
+            self.accel.remove_mesh(m as u32);
+        }
+    }
+
+    /// Rebuilds the emitters only (lights or the world changed; the materials did not).
+    pub fn refresh_lights(&mut self) -> Vec<String> {
+        let mut warnings = Vec::new();
+        let parts = LightParts::new(
+            &self.scene,
+            &self.programs,
+            self.camera_to_world,
+            (self.triangles, self.radius),
+            self.choice,
+            &mut warnings,
+        );
+        self.set_lights(parts);
+        warnings
+    }
+
+    /// Moves the camera without touching the BVH. Shading's Camera coordinates follow it; an
+    /// environment's importance map stays as it was built (a world graph that reads Camera
+    /// coordinates samples by the old map, still unbiased where it is not zero).
+    pub fn set_camera(&mut self, camera: Option<crate::scene::Camera>) {
+        self.scene.camera = camera;
+        self.camera_to_world = blender_camera_to_world(&self.scene);
+        for e in &mut self.emitters {
+            if let EmitterInstance::Area(a) = e {
+                a.camera_to_world = self.camera_to_world;
+            }
         }
     }
 

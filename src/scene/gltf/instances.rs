@@ -123,7 +123,10 @@ impl<'a> Loader<'a> {
         for u in uses {
             let own_weights = self.root.nodes[u.node].weights.is_some();
             if u.gpu.is_empty() && (placements[&u.mesh] == 1 || own_weights) {
-                self.instance_mesh(u.node, u.mesh, u.world, false)?;
+                let baked = self.instance_mesh(u.node, u.mesh, u.world, false)?;
+                let origins = &mut self.origins.mesh_node;
+                origins.resize(baked.start, None);
+                origins.resize(baked.end, Some(u.node));
                 continue;
             }
             let range = match stored.get(&u.mesh) {
@@ -165,6 +168,7 @@ impl<'a> Loader<'a> {
                     };
                 }
                 for mesh in range.clone() {
+                    self.origins.instance_node.push(u.node);
                     self.scene.instances.push(Instance {
                         mesh,
                         to_world: world,

@@ -14,6 +14,7 @@
 mod accessor;
 mod camera;
 mod container;
+mod document;
 mod instances;
 mod lights;
 mod material;
@@ -39,6 +40,8 @@ use serde_json::Value;
 
 use crate::scene::error::{LoadError, LoadErrorKind};
 use crate::scene::{RenderSettings, Scene};
+
+pub use document::{Document, Origins};
 
 /// Output limits: a scene beyond them is refused rather than exhausting memory.
 const MAX_TRIANGLES: usize = 1 << 25;
@@ -122,7 +125,16 @@ fn invalid(msg: String) -> LoadError {
 
 fn load_inner(bytes: &[u8], base_dir: Option<&Path>) -> Result<Scene, LoadError> {
     let c = container::split(bytes)?;
-    let raw: Value = serde_json::from_slice(c.json)
+    let raw = parse_json(c.json)?;
+    let root = typed_document(&raw)?;
+    let buffers = resolve_buffers(&root, c.bin, base_dir)?;
+    let buffer_refs: Vec<&[u8]> = buffers.iter().map(|b| &b[..]).collect();
+    load_parsed(&raw, &root, &buffer_refs, base_dir).map(|(scene, _)| scene)
+}
+
+/// The document's JSON, which must be an object.
+fn parse_json(json: &[u8]) -> Result<Value, LoadError> {
+    let raw: Value = serde_json::from_slice(json)
         .map_err(|e| LoadError::new(LoadErrorKind::Format, format!("invalid JSON: {e}")))?;
     if !raw.is_object() {
         return Err(LoadError::new(
@@ -130,7 +142,16 @@ fn load_inner(bytes: &[u8], base_dir: Option<&Path>) -> Result<Scene, LoadError>
             "not a glTF file: the JSON is not an object",
         ));
     }
-    let root = typed_document(&raw)?;
+    Ok(raw)
+}
+
+/// Loads a parsed document whose buffers are resolved (`buffers[i]` is buffer `i`).
+fn load_parsed(
+    raw: &Value,
+    root: &json::Root,
+    buffers: &[&[u8]],
+    base_dir: Option<&Path>,
+) -> Result<(Scene, Origins), LoadError> {
     let version = root.asset.version.trim();
     if !version.starts_with("2.") && version != "2" {
         return Err(LoadError::new(
@@ -157,16 +178,11 @@ fn load_inner(bytes: &[u8], base_dir: Option<&Path>) -> Result<Scene, LoadError>
             ));
         }
     }
-    let buffers = resolve_buffers(&root, c.bin, base_dir)?;
-    let buffer_refs: Vec<&[u8]> = buffers.iter().map(|b| &b[..]).collect();
     let mut loader = Loader {
-        root: &root,
-        raw: &raw,
+        root,
+        raw,
         base_dir,
-        reader: accessor::Reader {
-            root: &root,
-            buffers: &buffer_refs,
-        },
+        reader: accessor::Reader { root, buffers },
         scene: Scene {
             warnings,
             ..Default::default()
@@ -179,10 +195,17 @@ fn load_inner(bytes: &[u8], base_dir: Option<&Path>) -> Result<Scene, LoadError>
         warned: HashSet::new(),
         tri_total: 0,
         vert_total: 0,
+        origins: Origins::default(),
     };
     loader.root_extensions()?;
     loader.walk()?;
-    Ok(loader.scene)
+    let mut origins = loader.origins;
+    origins.mesh_node.resize(loader.scene.meshes.len(), None);
+    origins.material_gltf = vec![None; loader.scene.materials.len()];
+    for (&(gi, _), &m) in &loader.materials {
+        origins.material_gltf[m] = gi;
+    }
+    Ok((loader.scene, origins))
 }
 
 /// The typed document, deserialized by the `gltf` crate from a copy of the JSON that
@@ -382,6 +405,8 @@ pub(crate) struct Loader<'a> {
     /// Triangles and vertices emitted so far (checked against the limits).
     pub tri_total: usize,
     pub vert_total: usize,
+    /// Which node made each mesh, instance and light.
+    pub origins: Origins,
 }
 
 /// `raw[key]` as an object member, if present.
@@ -547,7 +572,11 @@ impl<'a> Loader<'a> {
                     gpu_random,
                 });
             }
+            self.origins.node_world.resize(n, Mat4::IDENTITY);
+            self.origins.node_world[ni] = world;
+            let lights = self.scene.lights.len();
             self.node_lights(ni, world)?;
+            (self.origins.light_node).resize(self.scene.lights.len().max(lights), ni);
             for c in node.children.iter().flatten().rev() {
                 stack.push((c.value(), world));
             }
