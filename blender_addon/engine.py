@@ -92,6 +92,10 @@ def renderer_args(binary, gltf, settings, width, height, region, pass_names=(), 
                          ("--clamp-indirect", "sample_clamp_indirect")):
         if getattr(settings, prop, 0.0) > 0.0:
             args += [option, repr(float(getattr(settings, prop)))]
+    for option, prop in (("--no-caustics-reflective", "caustics_reflective"),
+                         ("--no-caustics-refractive", "caustics_refractive")):
+        if not getattr(settings, prop, True):
+            args.append(option)
     filter_type = getattr(settings, "pixel_filter_type", "BOX")
     args += ["--filter", filter_type.lower().replace("_", "-"),
              "--filter-width", repr(float(getattr(settings, "filter_width", 1.0)))]

@@ -51,6 +51,14 @@ class TeselaSceneSettings(bpy.types.PropertyGroup):
     sample_clamp_indirect: FloatProperty(
         name="Indirect Light", default=10.0, min=0.0,
         description="If non-zero, the maximum value for an indirect light sample")
+    caustics_reflective: BoolProperty(
+        name="Reflective Caustics", default=True,
+        description="Use reflective caustics, resulting in a brighter image (more noise but "
+                    "added realism)")
+    caustics_refractive: BoolProperty(
+        name="Refractive Caustics", default=True,
+        description="Use refractive caustics, resulting in a brighter image (more noise but "
+                    "added realism)")
     use_adaptive_sampling: BoolProperty(
         name="Noise Threshold", default=True,
         description="Automatically stop sampling pixels whose noise falls below the threshold "

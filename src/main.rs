@@ -192,6 +192,14 @@ struct RenderArgs {
     /// Clamp indirect light (Cycles' sample_clamp_indirect; 0 = off). Path integrators.
     #[arg(long, default_value_t = 0.0, value_name = "C")]
     clamp_indirect: f32,
+    /// No reflective caustics (Cycles' caustics_reflective off): rays leaving a diffuse
+    /// bounce meet no glossy reflection. Path integrators.
+    #[arg(long)]
+    no_caustics_reflective: bool,
+    /// No refractive caustics (Cycles' caustics_refractive off): rays leaving a diffuse
+    /// bounce meet no refraction. Path integrators.
+    #[arg(long)]
+    no_caustics_refractive: bool,
     /// Pixel filter (Cycles' pixel_filter_type): box, gaussian or blackman-harris.
     #[arg(long, default_value = "box", value_parser = ["box", "gaussian", "blackman-harris"])]
     filter: String,
@@ -568,6 +576,8 @@ fn options(args: &RenderArgs, scene: &Scene) -> RenderOptions {
             transparent: args.transparent_bounces,
             clamp_direct: args.clamp_direct,
             clamp_indirect: args.clamp_indirect,
+            caustics_reflective: !args.no_caustics_reflective,
+            caustics_refractive: !args.no_caustics_refractive,
         },
         filter: tesela::film::PixelFilter::new(
             match args.filter.as_str() {

@@ -133,6 +133,9 @@ pub struct Ctx {
     pub camera_end: Option<Vec3>,
     /// The top level's traversal scratch, for scenes with instances.
     pub trav_top: Traversal,
+    /// Caustics the path integrator switched off ([`crate::integrator::light_paths::caustics`]
+    /// bits), for the shading of rays that left a diffuse bounce.
+    pub no_caustics: u8,
 }
 
 impl Ctx {
@@ -148,6 +151,7 @@ impl Ctx {
             trav: Traversal::default(),
             camera_end: None,
             trav_top: Traversal::default(),
+            no_caustics: 0,
         }
     }
 

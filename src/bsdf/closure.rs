@@ -106,6 +106,64 @@ pub fn from_closure(c: &Closure, u: f32) -> BsdfInstance {
     }
 }
 
+/// [`from_closure`] for a ray that left a diffuse bounce with some caustics switched off
+/// (`off`: [`crate::integrator::light_paths::caustics`] bits), as Cycles' closure setup leaves
+/// them out: without reflective caustics no Glossy, no Principled metal, specular layer or
+/// coat; without refractive ones no Refraction and no Principled transmission; a Glass without
+/// either is left out (with one of them it stays whole: an approximation). `None`: nothing of
+/// the closure is left.
+pub fn from_closure_without_caustics(c: &Closure, u: f32, off: u8) -> Option<BsdfInstance> {
+    use crate::integrator::light_paths::caustics::{NO_REFLECTIVE, NO_REFRACTIVE};
+    let (refl, refr) = (off & NO_REFLECTIVE != 0, off & NO_REFRACTIVE != 0);
+    match &c.kind {
+        ClosureKind::Glossy { .. } if refl => None,
+        ClosureKind::Refraction { .. } if refr => None,
+        ClosureKind::Glass { .. } if refl && refr => None,
+        // Cycles keeps the glass's reflection.
+        ClosureKind::Glass { roughness, ior, .. } if refr => {
+            let alpha = roughness * roughness;
+            Some(BsdfInstance::RoughDielectric(RoughDielectric::reflection(
+                Vec3::ONE,
+                *ior,
+                alpha,
+                alpha,
+            )))
+        }
+        ClosureKind::Principled(p) if p.cycles => {
+            let mut q = *p;
+            if refl {
+                q.specular_level = 0.0;
+                q.coat_weight = 0.0;
+            }
+            let black = Some(BsdfInstance::Diffuse(Diffuse::new(Vec3::ZERO)));
+            // The lobe choice of `principled`, with the left-out lobes black.
+            let metallic = q.metallic.clamp(0.0, 1.0);
+            let transmission = q.transmission.clamp(0.0, 1.0) * (1.0 - metallic);
+            if u < transmission {
+                if refr {
+                    // Cycles keeps the transmission lobe's reflection (a refraction-less glass).
+                    let alpha = q.roughness.clamp(0.0, 1.0).powi(2);
+                    return Some(BsdfInstance::RoughDielectric(
+                        RoughDielectric::principled_specular(q.specular_tint, q.ior, alpha, alpha)
+                            .multiscatter(),
+                    ));
+                }
+            } else {
+                let u2 = if transmission > 0.0 {
+                    (u - transmission) / (1.0 - transmission)
+                } else {
+                    u
+                };
+                if refl && u2 < metallic {
+                    return black;
+                }
+            }
+            Some(principled(&q, u))
+        }
+        _ => Some(from_closure(c, u)),
+    }
+}
+
 /// Blender's Principled BSDF (4.x/5.x): one of transmission, metal or the dielectric base is
 /// chosen with probability equal to its mixture weight; coat and sheen are layered on top.
 fn principled(p: &Principled, u: f32) -> BsdfInstance {

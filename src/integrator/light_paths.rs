@@ -21,6 +21,16 @@ pub struct LightPaths {
     /// light sampled at the first hit and emission met by the camera ray or the first bounce.
     pub clamp_direct: f32,
     pub clamp_indirect: f32,
+    /// Cycles' `caustics_reflective` / `caustics_refractive`: when off, a ray that left a
+    /// diffuse bounce meets no glossy reflection (resp. refraction) lobes.
+    pub caustics_reflective: bool,
+    pub caustics_refractive: bool,
+}
+
+/// Bits of [`LightPaths::no_caustics`].
+pub mod caustics {
+    pub const NO_REFLECTIVE: u8 = 1;
+    pub const NO_REFRACTIVE: u8 = 2;
 }
 
 impl Default for LightPaths {
@@ -33,11 +43,26 @@ impl Default for LightPaths {
             transparent: MAX_TRANSPARENT,
             clamp_direct: 0.0,
             clamp_indirect: 0.0,
+            caustics_reflective: true,
+            caustics_refractive: true,
         }
     }
 }
 
 impl LightPaths {
+    /// The caustics switched off, as [`caustics`] bits.
+    #[inline]
+    pub fn no_caustics(&self) -> u8 {
+        let mut m = 0;
+        if !self.caustics_reflective {
+            m |= caustics::NO_REFLECTIVE;
+        }
+        if !self.caustics_refractive {
+            m |= caustics::NO_REFRACTIVE;
+        }
+        m
+    }
+
     /// The contribution `c` clamped as Cycles clamps it (`direct`: see the fields).
     #[inline]
     pub fn clamp(&self, c: Vec3, direct: bool) -> Vec3 {

@@ -129,8 +129,19 @@ impl ShadingPoint {
         depth: u32,
     ) -> Option<Self> {
         let u = ctx.sampler.next_1d();
+        let caustics_off =
+            if depth > 1 && ctx.ray_flags & crate::shading::globals::ray::DIFFUSE != 0 {
+                ctx.no_caustics
+            } else {
+                0
+            };
         let (closure, inv_p, u) = scene.choose_closure(ctx, its, d, depth, u)?;
-        let bsdf = bsdf::from_closure(closure, u);
+        let bsdf = if caustics_off == 0 {
+            bsdf::from_closure(closure, u)
+        } else {
+            // Cycles leaves the closures of the caustics switched off out.
+            bsdf::closure::from_closure_without_caustics(closure, u, caustics_off)?
+        };
         // The closure's normal faces the viewer (Cycles' N); zero means the shading normal.
         let mut n = if closure.normal == Vec3::ZERO {
             its.ns
@@ -462,11 +473,11 @@ impl ShadingPoint {
 
     /// Light Path bits of a ray sampled from this point.
     #[inline]
-    fn ray_flags(&self, rec: &BsdfQueryRecord, reflect: bool) -> u32 {
+    fn ray_flags(&self, rec: &BsdfQueryRecord, reflect: bool, diffuse: bool) -> u32 {
         use crate::shading::globals::ray;
         let kind = if rec.measure == bsdf::Measure::Discrete {
             ray::GLOSSY | ray::SINGULAR
-        } else if matches!(self.bsdf, BsdfInstance::Diffuse(_)) {
+        } else if diffuse {
             ray::DIFFUSE
         } else {
             ray::GLOSSY
@@ -475,6 +486,36 @@ impl ShadingPoint {
             ray::REFLECTION
         } else {
             ray::TRANSMISSION
+        }
+    }
+
+    /// Whether the lobe `sample` picks with the random number `u1` for the incident local
+    /// direction `wi` (of the lobe that makes the choice) is one of Cycles' diffuse closures:
+    /// a Lambertian, translucent or sheen lobe, or the diffuse base of a layered or plastic
+    /// BSDF when the choice falls below its top.
+    #[inline]
+    fn sampled_diffuse(&self, wi: Vec3, u1: f32) -> bool {
+        use bsdf::layered::{BaseLobe, TopLobe};
+        match &self.bsdf {
+            BsdfInstance::Diffuse(_) | BsdfInstance::Translucent(_) | BsdfInstance::Sheen(_) => {
+                true
+            }
+            BsdfInstance::Plastic(p) => wi.z > 0.0 && u1 >= p.coat_share(wi.z),
+            BsdfInstance::Layered(l) => {
+                let p = l.top_probability(wi);
+                if u1 < p {
+                    return matches!(l.top, TopLobe::Sheen(_));
+                }
+                // The base's own choice, with the number rescaled as Layered rescales it.
+                let u2 = ((u1 - p) / (1.0 - p)).clamp(0.0, 1.0);
+                match &l.base {
+                    BaseLobe::Diffuse(_) | BaseLobe::Translucent(_) => true,
+                    BaseLobe::CoatedDiffuse(inner) => u2 >= inner.top_probability(wi),
+                    BaseLobe::SpecularDiffuse(inner) => u2 >= inner.top_probability(wi),
+                    _ => false,
+                }
+            }
+            _ => false,
         }
     }
 
@@ -501,7 +542,7 @@ impl ShadingPoint {
         let u1 = ctx.sampler.next_1d();
         if let Some(g) = &self.glossy_frame {
             let (wo, rec) = self.two_frame_sample(g, d, u, u1)?;
-            ctx.ray_flags = self.ray_flags(&rec, true);
+            ctx.ray_flags = self.ray_flags(&rec, true, self.sampled_diffuse(g.to_local(-d), u1));
             if its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
                 return None;
             }
@@ -515,7 +556,7 @@ impl ShadingPoint {
         let wo = self.frame.to_world(rec.wo);
         // A reflection must leave on the viewer's side of the true surface.
         let reflect = !self.bsdf.is_transmissive() || rec.wo.z * self.wi.z > 0.0;
-        ctx.ray_flags = self.ray_flags(&rec, reflect);
+        ctx.ray_flags = self.ray_flags(&rec, reflect, self.sampled_diffuse(self.wi, u1));
         if reflect && its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
             return None;
         }

@@ -86,6 +86,7 @@ impl PathMats {
         let mut depth = 1;
         let mut transparent = 0;
         let (mut counts, mut end) = (BounceCount::default(), self.max_depth);
+        ctx.no_caustics = self.paths.no_caustics();
         loop {
             let last = depth >= end;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
@@ -178,6 +179,7 @@ impl PathMis {
         // and delta samples (emitter sampling could not have produced them: MIS weight 1).
         let mut bsdf_pdf = f32::INFINITY;
         let (mut counts, mut end) = (BounceCount::default(), self.max_depth);
+        ctx.no_caustics = self.paths.no_caustics();
         loop {
             let last = depth >= end;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, bsdf_pdf);

@@ -851,6 +851,7 @@ impl State {
                 transparent: s.transparent_bounces,
                 clamp_direct: s.clamp_direct,
                 clamp_indirect: s.clamp_indirect,
+                ..Default::default()
             },
         };
         Some((opts, window))

@@ -41,8 +41,8 @@ def parse_args(argv):
         if a == "--pipe":
             opts["pipe"] = True
             i += 1
-        elif a == "--denoise":
-            opts["denoise"] = True
+        elif a in ("--denoise", "--no-caustics-reflective", "--no-caustics-refractive"):
+            opts[a[2:].replace("-", "_")] = True
             i += 1
         elif a == "--region":
             opts["region"] = [int(v) for v in argv[i + 1:i + 5]]

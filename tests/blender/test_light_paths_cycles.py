@@ -43,6 +43,9 @@ CASES = [
     ("glossy_0_transmission_1", {"glossy_bounces": 0, "transmission_bounces": 1}, 512, 1024),
     ("clamp_indirect_0.3", {"sample_clamp_indirect": 0.3}, 512, 1024),
     ("clamp_direct_1", {"sample_clamp_direct": 1.0}, 512, 1024),
+    # Rays leaving the walls and floor meet neither the mirror's nor the glass's lobes.
+    ("no_caustics", {"caustics_reflective": False, "caustics_refractive": False}, 512, 1024),
+    ("no_refractive_caustics", {"caustics_refractive": False}, 512, 1024),
 ]
 
 
