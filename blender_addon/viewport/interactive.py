@@ -46,6 +46,8 @@ def session_settings(scene, pixel_size):
             "transparent_bounces": int(s.transparent_max_bounces),
             "clamp_direct": float(s.sample_clamp_direct),
             "clamp_indirect": float(s.sample_clamp_indirect),
+            "caustics_reflective": bool(s.caustics_reflective),
+            "caustics_refractive": bool(s.caustics_refractive),
             "filter": s.pixel_filter_type.lower().replace("_", "-"),
             "filter_width": float(s.filter_width),
             "film_transparent": bool(scene.render.film_transparent)}

@@ -36,6 +36,8 @@ pub struct Settings {
     pub transparent_bounces: u32,
     pub clamp_direct: f32,
     pub clamp_indirect: f32,
+    pub caustics_reflective: bool,
+    pub caustics_refractive: bool,
     pub filter: FilterType,
     pub filter_width: f32,
     pub film_transparent: Option<bool>,
@@ -58,6 +60,8 @@ impl Default for Settings {
             transparent_bounces: 8,
             clamp_direct: 0.0,
             clamp_indirect: 0.0,
+            caustics_reflective: true,
+            caustics_refractive: true,
             filter: FilterType::Box,
             filter_width: 1.0,
             film_transparent: None,
@@ -145,6 +149,8 @@ impl Settings {
                     s.filter_width = w;
                 }
                 "film_transparent" => s.film_transparent = Some(boolean()?),
+                "caustics_reflective" => s.caustics_reflective = boolean()?,
+                "caustics_refractive" => s.caustics_refractive = boolean()?,
                 _ => unknown.push(k.clone()),
             }
         }
@@ -851,7 +857,8 @@ impl State {
                 transparent: s.transparent_bounces,
                 clamp_direct: s.clamp_direct,
                 clamp_indirect: s.clamp_indirect,
-                ..Default::default()
+                caustics_reflective: s.caustics_reflective,
+                caustics_refractive: s.caustics_refractive,
             },
         };
         Some((opts, window))
