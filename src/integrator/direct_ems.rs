@@ -7,9 +7,9 @@
 //! glass) has no density to sample a light against, so the surface shows only its emission:
 //! a mirror's reflection of a light is black.
 
-use super::light_split::{ClassWeights, LightSplit, NoSplit, Sink};
+use super::light_split::{ClassWeights, Sink, SplitsLight};
 use super::path::report;
-use super::{Integrator, MAX_TRANSPARENT, ShadingPoint, sample_emitter_towards, spawn, trace_lit};
+use super::{MAX_TRANSPARENT, ShadingPoint, sample_emitter_towards, spawn, trace_lit};
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
 
@@ -20,28 +20,7 @@ pub struct DirectEms {
     pub follow_delta: bool,
 }
 
-impl Integrator for DirectEms {
-    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
-        self.run(scene, ctx, o, d, &mut NoSplit)
-    }
-
-    fn splits_light(&self) -> bool {
-        true
-    }
-
-    fn li_split(
-        &self,
-        scene: &RenderScene,
-        ctx: &mut Ctx,
-        o: Vec3,
-        d: Vec3,
-        split: &mut LightSplit,
-    ) -> Vec3 {
-        self.run(scene, ctx, o, d, split)
-    }
-}
-
-impl DirectEms {
+impl SplitsLight for DirectEms {
     #[inline(always)]
     fn run<S: Sink>(
         &self,

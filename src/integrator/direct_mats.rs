@@ -1,9 +1,9 @@
 //! Direct illumination by BSDF sampling (the seed's `direct_mats`): one BSDF sample at the
 //! first non-delta surface; its ray counts the radiance of whatever emitter it hits.
 
-use super::light_split::{ClassWeights, LightSplit, NoSplit, Sink};
+use super::light_split::{ClassWeights, Sink, SplitsLight};
 use super::path::report;
-use super::{Integrator, MAX_TRANSPARENT, ShadingPoint, spawn, trace_lit};
+use super::{MAX_TRANSPARENT, ShadingPoint, spawn, trace_lit};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
@@ -12,28 +12,7 @@ pub struct DirectMats {
     pub max_depth: u32,
 }
 
-impl Integrator for DirectMats {
-    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
-        self.run(scene, ctx, o, d, &mut NoSplit)
-    }
-
-    fn splits_light(&self) -> bool {
-        true
-    }
-
-    fn li_split(
-        &self,
-        scene: &RenderScene,
-        ctx: &mut Ctx,
-        o: Vec3,
-        d: Vec3,
-        split: &mut LightSplit,
-    ) -> Vec3 {
-        self.run(scene, ctx, o, d, split)
-    }
-}
-
-impl DirectMats {
+impl SplitsLight for DirectMats {
     #[inline(always)]
     fn run<S: Sink>(
         &self,

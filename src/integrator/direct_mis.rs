@@ -3,11 +3,9 @@
 //! heuristic. Delta BSDF samples and delta lights get weight 1 (the other strategy cannot
 //! produce them). The light-choice probability is part of the emitter density on both sides.
 
-use super::light_split::{ClassWeights, LightSplit, NoSplit, Sink};
+use super::light_split::{ClassWeights, Sink, SplitsLight};
 use super::path::report;
-use super::{
-    Integrator, MAX_TRANSPARENT, ShadingPoint, mis_weight, sample_emitter_towards, spawn, trace_lit,
-};
+use super::{MAX_TRANSPARENT, ShadingPoint, mis_weight, sample_emitter_towards, spawn, trace_lit};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
@@ -16,28 +14,7 @@ pub struct DirectMis {
     pub max_depth: u32,
 }
 
-impl Integrator for DirectMis {
-    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
-        self.run(scene, ctx, o, d, &mut NoSplit)
-    }
-
-    fn splits_light(&self) -> bool {
-        true
-    }
-
-    fn li_split(
-        &self,
-        scene: &RenderScene,
-        ctx: &mut Ctx,
-        o: Vec3,
-        d: Vec3,
-        split: &mut LightSplit,
-    ) -> Vec3 {
-        self.run(scene, ctx, o, d, split)
-    }
-}
-
-impl DirectMis {
+impl SplitsLight for DirectMis {
     #[inline(always)]
     fn run<S: Sink>(
         &self,

@@ -6,7 +6,9 @@
 //! The path integrators are generic over a [`Sink`]: [`NoSplit`] compiles to nothing, so a
 //! render without light passes runs the same code as before.
 
+use super::Integrator;
 use crate::bsdf::{Bsdf, BsdfQueryRecord, Measure};
+use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
 
 /// The share of a path's radiance that goes to the diffuse and the glossy passes, per
@@ -76,6 +78,41 @@ pub trait Sink {
     fn camera(&mut self, c: Vec3);
     /// Radiance `c` that came through the first bounce, with that bounce's weights.
     fn bounced(&mut self, c: Vec3, w: &ClassWeights, direct: bool);
+}
+
+/// An integrator whose one path loop, generic over its [`Sink`], serves both
+/// [`Integrator::li`] (with [`NoSplit`], compiling to the plain loop) and
+/// [`Integrator::li_split`].
+pub trait SplitsLight: Send + Sync {
+    fn run<S: Sink>(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        sink: &mut S,
+    ) -> Vec3;
+}
+
+impl<T: SplitsLight> Integrator for T {
+    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
+        self.run(scene, ctx, o, d, &mut NoSplit)
+    }
+
+    fn splits_light(&self) -> bool {
+        true
+    }
+
+    fn li_split(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        split: &mut LightSplit,
+    ) -> Vec3 {
+        self.run(scene, ctx, o, d, split)
+    }
 }
 
 /// No light passes.

@@ -3,8 +3,8 @@
 //! throughput's **maximum** component, survival probability capped at 0.95.
 
 use super::light_paths::{BounceCount, LightPaths};
-use super::light_split::{ClassWeights, LightSplit, NoSplit, Sink};
-use super::{Integrator, ShadingPoint, mis_weight, sample_emitter_towards, spawn, trace_lit};
+use super::light_split::{ClassWeights, Sink, SplitsLight};
+use super::{ShadingPoint, mis_weight, sample_emitter_towards, spawn, trace_lit};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
@@ -49,28 +49,7 @@ fn roulette(ctx: &mut Ctx, depth: u32, throughput: &mut Vec3) -> bool {
     true
 }
 
-impl Integrator for PathMats {
-    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
-        self.run(scene, ctx, o, d, &mut NoSplit)
-    }
-
-    fn splits_light(&self) -> bool {
-        true
-    }
-
-    fn li_split(
-        &self,
-        scene: &RenderScene,
-        ctx: &mut Ctx,
-        o: Vec3,
-        d: Vec3,
-        split: &mut LightSplit,
-    ) -> Vec3 {
-        self.run(scene, ctx, o, d, split)
-    }
-}
-
-impl PathMats {
+impl SplitsLight for PathMats {
     #[inline(always)]
     fn run<S: Sink>(
         &self,
@@ -139,28 +118,7 @@ impl PathMats {
     }
 }
 
-impl Integrator for PathMis {
-    fn li(&self, scene: &RenderScene, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Vec3 {
-        self.run(scene, ctx, o, d, &mut NoSplit)
-    }
-
-    fn splits_light(&self) -> bool {
-        true
-    }
-
-    fn li_split(
-        &self,
-        scene: &RenderScene,
-        ctx: &mut Ctx,
-        o: Vec3,
-        d: Vec3,
-        split: &mut LightSplit,
-    ) -> Vec3 {
-        self.run(scene, ctx, o, d, split)
-    }
-}
-
-impl PathMis {
+impl SplitsLight for PathMis {
     #[inline(always)]
     fn run<S: Sink>(
         &self,
