@@ -593,24 +593,30 @@ def _render_result_mean():
     return _render_result_image().reshape(-1, 3).mean(axis=0)
 
 
-def addon_bench(args):
-    """Tesela (through the add-on, path_mis depth b + 2) against Cycles (max bounces b) on Blender
-    scenes at the same spp: median wall time of `repeats` renders in alternation, and the
-    marginal samples/s `pixels (spp - 1) / (t(spp) - t(1))`, which leaves out the per-render
-    costs (sync, export, BVH, process start) that both have."""
-    import bpy
+def _addon_setup(args):
+    """Registers the add-on (renderer `args.tesela`) and returns the Blender tests' scene module
+    (tests/blender/scenes.py: the test modules import their own `scenes`, not bench/scenes.py)."""
     tests = REPO / "tests" / "blender"
     for path in (REPO, tests):
         sys.path.insert(0, str(path))
-    # The test modules import their own `scenes` (tests/blender/scenes.py), not bench/scenes.py.
     sys.modules.pop("scenes", None)
-    import importlib
     import blender_addon
     import scenes as bs
     from blender_addon import engine as tesela_engine
     if not tesela_engine.TeselaRenderEngine.is_registered:
         blender_addon.register()
     os.environ["TESELA_BINARY"] = str(args.tesela)
+    return bs
+
+
+def addon_bench(args):
+    """Tesela (through the add-on, path_mis depth b + 2) against Cycles (max bounces b) on Blender
+    scenes at the same spp: median wall time of `repeats` renders in alternation, and the
+    marginal samples/s `pixels (spp - 1) / (t(spp) - t(1))`, which leaves out the per-render
+    costs (sync, export, BVH, process start) that both have."""
+    import bpy
+    import importlib
+    bs = _addon_setup(args)
     size = args.size or (48 if args.quick else 256)
     spp = 4 if args.quick else args.addon_spp
     bounces = 3
@@ -684,16 +690,7 @@ def clean_bench(args):
     noise thresholds, so its time at Cycles' error can be read off."""
     import bpy
     import importlib
-    tests = REPO / "tests" / "blender"
-    for path in (REPO, tests):
-        sys.path.insert(0, str(path))
-    sys.modules.pop("scenes", None)
-    import blender_addon
-    import scenes as bs
-    from blender_addon import engine as tesela_engine
-    if not tesela_engine.TeselaRenderEngine.is_registered:
-        blender_addon.register()
-    os.environ["TESELA_BINARY"] = str(args.tesela)
+    bs = _addon_setup(args)
     size = args.size or (48 if args.quick else 128)
     ref_spp = 64 if args.quick else args.clean_ref_spp
     bounces = 3
@@ -749,16 +746,7 @@ def equal_time_bench(args):
     corrected for the reference's own noise, which is the error at spp scaled by spp / ref spp)."""
     import bpy
     import importlib
-    tests = REPO / "tests" / "blender"
-    for path in (REPO, tests):
-        sys.path.insert(0, str(path))
-    sys.modules.pop("scenes", None)
-    import blender_addon
-    import scenes as bs
-    from blender_addon import engine as tesela_engine
-    if not tesela_engine.TeselaRenderEngine.is_registered:
-        blender_addon.register()
-    os.environ["TESELA_BINARY"] = str(args.tesela)
+    bs = _addon_setup(args)
     size = args.size or (48 if args.quick else 128)
     ref_spp = 64 if args.quick else args.clean_ref_spp
     spp = 4 if args.quick else args.addon_spp
