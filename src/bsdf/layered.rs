@@ -221,6 +221,19 @@ impl Layer for Sheen {
     }
 }
 
+/// The top lobe is chosen when `u1 < p`; `u1` is then rescaled to `[0, 1)` for the lobe.
+#[inline]
+fn pick(p: f32, u1: f32) -> (bool, f32) {
+    if u1 < p {
+        (true, (u1 / p).min(1.0 - f32::EPSILON / 2.0))
+    } else {
+        (
+            false,
+            ((u1 - p) / (1.0 - p)).clamp(0.0, 1.0 - f32::EPSILON / 2.0),
+        )
+    }
+}
+
 /// `f_top + A(wi) ⊙ f_base` (see the module documentation).
 #[derive(Clone, Copy, Debug)]
 pub struct Layered<T, B> {
@@ -254,6 +267,13 @@ impl<T: Layer, B: Bsdf> Layered<T, B> {
     #[inline]
     pub fn top_probability(&self, wi: Vec3) -> f32 {
         self.split(wi).0
+    }
+
+    /// `sample`'s lobe choice for `wi` with the random number `u1`: `(top, u1')`, `u1'` the
+    /// number rescaled for the chosen lobe's own choices.
+    #[inline]
+    pub fn pick(&self, wi: Vec3, u1: f32) -> (bool, f32) {
+        pick(self.top_probability(wi), u1)
     }
 
     /// `A(wi)`, the factor on everything below the top.
@@ -297,12 +317,10 @@ where
 impl<T: Layer, B: Bsdf> Bsdf for Layered<T, B> {
     fn sample(&self, rec: &mut BsdfQueryRecord, u: Vec2, u1: f32) -> Vec3 {
         let (p, att) = self.split(rec.wi);
-        let top = u1 < p;
+        let (top, u1) = pick(p, u1);
         let w = if top {
-            self.top
-                .sample(rec, u, (u1 / p).min(1.0 - f32::EPSILON / 2.0))
+            self.top.sample(rec, u, u1)
         } else {
-            let u1 = ((u1 - p) / (1.0 - p)).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
             self.base.sample(rec, u, u1)
         };
         if w == Vec3::ZERO {

@@ -406,17 +406,15 @@ impl ShadingPoint {
             return None;
         };
         let wi_g = g.to_local(-d);
-        let p = l.top_probability(wi_g);
-        let (frame, mut rec) = if u1 < p {
+        let (top, u1) = l.pick(wi_g, u1);
+        let (frame, mut rec) = if top {
             (g, BsdfQueryRecord::new(wi_g))
         } else {
             (&self.frame, BsdfQueryRecord::new(self.wi))
         };
-        let w = if u1 < p {
-            l.top
-                .sample(&mut rec, u, (u1 / p).min(1.0 - f32::EPSILON / 2.0))
+        let w = if top {
+            l.top.sample(&mut rec, u, u1)
         } else {
-            let u1 = ((u1 - p) / (1.0 - p)).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
             l.base.sample(&mut rec, u, u1)
         };
         if w == Vec3::ZERO {
@@ -502,16 +500,15 @@ impl ShadingPoint {
             }
             BsdfInstance::Plastic(p) => wi.z > 0.0 && u1 >= p.coat_share(wi.z),
             BsdfInstance::Layered(l) => {
-                let p = l.top_probability(wi);
-                if u1 < p {
+                let (top, u2) = l.pick(wi, u1);
+                if top {
                     return matches!(l.top, TopLobe::Sheen(_));
                 }
-                // The base's own choice, with the number rescaled as Layered rescales it.
-                let u2 = ((u1 - p) / (1.0 - p)).clamp(0.0, 1.0);
+                // The base's own choice, with the number Layered passes it.
                 match &l.base {
                     BaseLobe::Diffuse(_) | BaseLobe::Translucent(_) => true,
-                    BaseLobe::CoatedDiffuse(inner) => u2 >= inner.top_probability(wi),
-                    BaseLobe::SpecularDiffuse(inner) => u2 >= inner.top_probability(wi),
+                    BaseLobe::CoatedDiffuse(inner) => !inner.pick(wi, u2).0,
+                    BaseLobe::SpecularDiffuse(inner) => !inner.pick(wi, u2).0,
                     _ => false,
                 }
             }
