@@ -296,7 +296,7 @@ impl ShadingPoint {
             return Vec3::ZERO;
         }
         if let Some(g) = &self.glossy_frame {
-            return self.two_frame_eval_cos(g, d, wo, true) * self.weight;
+            return self.two_frame_eval_cos_pdf(g, d, wo, true).0 * self.weight;
         }
         let rec = BsdfQueryRecord::pair(self.wi, lo);
         match self.smooth {
@@ -314,7 +314,7 @@ impl ShadingPoint {
         }
         match (&self.glossy_frame, self.smooth) {
             (Some(g), _) => {
-                let (f, pdf) = self.two_frame_eval_cos_pdf(g, d, wo);
+                let (f, pdf) = self.two_frame_eval_cos_pdf(g, d, wo, true);
                 (f * self.weight, pdf)
             }
             (None, None) => {
@@ -326,9 +326,13 @@ impl ShadingPoint {
         }
     }
 
-    /// [`Self::two_frame_eval_cos`] (for evaluation) and [`Self::two_frame_pdf`] together.
+    /// `f · |cos|` (without the closure weight) of a specular layer in frame `g` over the
+    /// diffuse base in `self.frame`, each with its own normal's cosine and bump correction (as
+    /// for evaluation when `is_eval`, else for a sample), as Cycles' two closures:
+    /// `A(wi_g) f_d(wi, wo) |n·wo| + f_s(wi_g, wo_g) |m·wo|`; and with it the density
+    /// [`Self::two_frame_pdf`] (one microfacet evaluation gives both).
     #[inline]
-    fn two_frame_eval_cos_pdf(&self, g: &Frame, d: Vec3, wo: Vec3) -> (Vec3, f32) {
+    fn two_frame_eval_cos_pdf(&self, g: &Frame, d: Vec3, wo: Vec3, is_eval: bool) -> (Vec3, f32) {
         let BsdfInstance::Layered(l) = &self.bsdf else {
             return (Vec3::ZERO, 0.0);
         };
@@ -337,8 +341,8 @@ impl ShadingPoint {
         let att = l.attenuation_at(wi_g);
         let (fb, pb) = l.base.eval_and_pdf(&BsdfQueryRecord::pair(self.wi, lo));
         let (ft, pt) = l.top.eval_and_pdf(&BsdfQueryRecord::pair(wi_g, wo_g));
-        let base = att * fb * lo.z.abs() * Self::bump_term(self.frame.n, ns, wo, true, true);
-        let top = ft * wo_g.z.abs() * Self::bump_term(g.n, ns, wo, true, false);
+        let base = att * fb * lo.z.abs() * Self::bump_term(self.frame.n, ns, wo, is_eval, true);
+        let top = ft * wo_g.z.abs() * Self::bump_term(g.n, ns, wo, is_eval, false);
         let p = l.top_probability(wi_g);
         (base + top, p * pt + (1.0 - p) * pb)
     }
@@ -357,28 +361,7 @@ impl ShadingPoint {
         }
     }
 
-    /// `f · |cos|` (without the closure weight) of a specular layer in frame `g` over the
-    /// diffuse base in `self.frame`, each with its own normal's cosine and bump correction, as
-    /// Cycles' two closures: `A(wi_g) f_d(wi, wo) |n·wo| + f_s(wi_g, wo_g) |m·wo|`.
-    #[inline]
-    fn two_frame_eval_cos(&self, g: &Frame, d: Vec3, wo: Vec3, is_eval: bool) -> Vec3 {
-        let BsdfInstance::Layered(l) = &self.bsdf else {
-            return Vec3::ZERO;
-        };
-        let ns = self.smooth.unwrap_or(self.frame.n);
-        let (wi_g, wo_g, lo) = (g.to_local(-d), g.to_local(wo), self.frame.to_local(wo));
-        let att = l.attenuation_at(wi_g);
-        let base = att
-            * l.base.eval(&BsdfQueryRecord::pair(self.wi, lo))
-            * lo.z.abs()
-            * Self::bump_term(self.frame.n, ns, wo, is_eval, true);
-        let top = l.top.eval(&BsdfQueryRecord::pair(wi_g, wo_g))
-            * wo_g.z.abs()
-            * Self::bump_term(g.n, ns, wo, is_eval, false);
-        base + top
-    }
-
-    /// The density (per steradian) of [`Self::two_frame_eval_cos`]'s sampling: the glossy
+    /// The density (per steradian) of [`Self::two_frame_eval_cos_pdf`]'s sampling: the glossy
     /// layer with Layered's probability `p(wi_g)`, else the base.
     #[inline]
     fn two_frame_pdf(&self, g: &Frame, d: Vec3, wo: Vec3) -> f32 {
@@ -393,7 +376,8 @@ impl ShadingPoint {
                     .pdf(&BsdfQueryRecord::pair(self.wi, self.frame.to_local(wo)))
     }
 
-    /// Samples the two-frame pair: `(world direction, f cos / pdf without the weight)`.
+    /// Samples the two-frame pair: the world direction and its record, local to `self.frame`
+    /// (its density comes with the value, from [`Self::two_frame_eval_cos_pdf`]).
     #[inline]
     fn two_frame_sample(
         &self,
@@ -423,8 +407,7 @@ impl ShadingPoint {
         let wo = frame.to_world(rec.wo);
         rec.wo = self.frame.to_local(wo);
         rec.wi = self.wi;
-        rec.pdf = self.two_frame_pdf(g, d, wo);
-        (rec.pdf > 0.0 && rec.pdf.is_finite()).then_some((wo, rec))
+        Some((wo, rec))
     }
 
     /// The chosen BSDF is one of Cycles' diffuse closures (`CLOSURE_IS_BSDF_DIFFUSE`).
@@ -538,12 +521,17 @@ impl ShadingPoint {
         let u = ctx.sampler.next_2d();
         let u1 = ctx.sampler.next_1d();
         if let Some(g) = &self.glossy_frame {
-            let (wo, rec) = self.two_frame_sample(g, d, u, u1)?;
+            let (wo, mut rec) = self.two_frame_sample(g, d, u, u1)?;
+            let (f, pdf) = self.two_frame_eval_cos_pdf(g, d, wo, false);
+            if !(pdf > 0.0 && pdf.is_finite()) {
+                return None;
+            }
+            rec.pdf = pdf;
             ctx.ray_flags = self.ray_flags(&rec, true, self.sampled_diffuse(g.to_local(-d), u1));
             if its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
                 return None;
             }
-            let w = self.two_frame_eval_cos(g, d, wo, false) / rec.pdf * self.weight;
+            let w = f / rec.pdf * self.weight;
             return (w != Vec3::ZERO && w.is_finite()).then_some((wo, w, rec));
         }
         let w = self.bsdf.sample(&mut rec, u, u1) * self.weight;
