@@ -29,7 +29,8 @@ pub enum BumpOp {
     },
 }
 
-fn safe_normalize(v: Vec3) -> Vec3 {
+/// `v / |v|`, or zero for a zero, infinite or NaN `v`.
+pub(super) fn safe_normalize(v: Vec3) -> Vec3 {
     let l = v.length();
     if l > 0.0 && l.is_finite() {
         v / l

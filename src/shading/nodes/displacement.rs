@@ -49,15 +49,7 @@ fn object_to_world(g: &ShaderGlobals) -> Option<Mat3> {
     g.object_to_world_linear()
 }
 
-#[inline]
-fn safe_normalize(v: Vec3) -> Vec3 {
-    let l = v.length();
-    if l > 0.0 && l.is_finite() {
-        v / l
-    } else {
-        Vec3::ZERO
-    }
-}
+use super::bump::safe_normalize;
 
 impl DisplacementOp {
     #[inline]
