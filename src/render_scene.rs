@@ -454,15 +454,7 @@ impl RenderScene {
         let (programs, mut warnings) = compile_programs(&self.scene);
         self.programs = programs;
         self.passes = self.programs.iter().any(|p| p.may_pass());
-        let parts = LightParts::new(
-            &self.scene,
-            &self.programs,
-            self.camera_to_world,
-            (self.triangles, self.radius),
-            self.choice,
-            &mut warnings,
-        );
-        self.set_lights(parts);
+        warnings.extend(self.refresh_lights());
         warnings
     }
 
