@@ -2,6 +2,8 @@
 
 * Without an importable ``bpy`` (Blender as a Python module) every test module here is reported as
   skipped, with the reason, instead of failing to import.
+* The ``addon`` fixture registers the Tesela add-on for a test module (and unregisters it after,
+  if the module registered it).
 * The ``tesela_bin`` fixture finds the renderer: env ``TESELA_BIN``, else
   ``<repo>/target/release/tesela``. A missing binary skips the tests that need it, except under
   ``CI=true``, where it fails them.
@@ -54,3 +56,19 @@ def tesela_bin():
             pytest.fail(msg)
         pytest.skip(msg)
     return path
+
+
+@pytest.fixture(scope="module")
+def addon():
+    """The Tesela add-on registered while the module's tests run."""
+    if str(REPO) not in sys.path:
+        sys.path.insert(0, str(REPO))
+    import blender_addon
+    from blender_addon import engine as tesela_engine
+
+    registered = tesela_engine.TeselaRenderEngine.is_registered
+    if not registered:
+        blender_addon.register()
+    yield
+    if not registered and tesela_engine.TeselaRenderEngine.is_registered:
+        blender_addon.unregister()

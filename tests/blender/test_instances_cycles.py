@@ -20,23 +20,11 @@ REPO = HERE.parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-import blender_addon  # noqa: E402
-from blender_addon import engine as tesela_engine  # noqa: E402
 from blender_addon.export.gltf import write_gltf  # noqa: E402
 from test_addon import result_pixels  # noqa: E402
 
 SIZE = 64
 GRID = 10  # 10 x 10 points: 100 instances, past the add-on's GPU-instancing threshold
-
-
-@pytest.fixture(scope="module")
-def addon():
-    registered = tesela_engine.TeselaRenderEngine.is_registered
-    if not registered:
-        blender_addon.register()
-    yield
-    if not registered and tesela_engine.TeselaRenderEngine.is_registered:
-        blender_addon.unregister()
 
 
 def scatter():

@@ -34,8 +34,6 @@ REPO = HERE.parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-import blender_addon  # noqa: E402
-from blender_addon import engine as tesela_engine  # noqa: E402
 
 W, H = 32, 32
 SPP = 2048
@@ -43,16 +41,6 @@ BOUNCES = 4
 CLASSES = ("Diffuse", "Glossy", "Transmission")
 TOGGLES = ["use_pass_emit", "use_pass_environment"] + [
     f"use_pass_{c.lower()}_{k}" for c in CLASSES for k in ("direct", "indirect", "color")]
-
-
-@pytest.fixture(scope="module")
-def addon():
-    registered = tesela_engine.TeselaRenderEngine.is_registered
-    if not registered:
-        blender_addon.register()
-    yield
-    if not registered and tesela_engine.TeselaRenderEngine.is_registered:
-        blender_addon.unregister()
 
 
 def diffuse_and_glossy():

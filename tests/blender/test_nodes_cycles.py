@@ -59,23 +59,11 @@ REPO = HERE.parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-import blender_addon  # noqa: E402
-from blender_addon import engine as tesela_engine  # noqa: E402
 from test_addon import result_pixels  # noqa: E402
 
 N = 64           # image side in pixels
 OFF = 1e-3       # discontinuous outputs: a pixel is "off" beyond this error
 HALF = N // 2    # pixels per metre across the [-1, 1] view
-
-
-@pytest.fixture(scope="module")
-def addon():
-    registered = tesela_engine.TeselaRenderEngine.is_registered
-    if not registered:
-        blender_addon.register()
-    yield
-    if not registered and tesela_engine.TeselaRenderEngine.is_registered:
-        blender_addon.unregister()
 
 
 # --------------------------------------------------------------------------------------------

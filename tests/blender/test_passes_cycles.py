@@ -31,21 +31,9 @@ REPO = HERE.parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-import blender_addon  # noqa: E402
-from blender_addon import engine as tesela_engine  # noqa: E402
 
 W, H = 80, 60
 SPP = 32
-
-
-@pytest.fixture(scope="module")
-def addon():
-    registered = tesela_engine.TeselaRenderEngine.is_registered
-    if not registered:
-        blender_addon.register()
-    yield
-    if not registered and tesela_engine.TeselaRenderEngine.is_registered:
-        blender_addon.unregister()
 
 
 def build_scene():

@@ -25,8 +25,6 @@ REPO = HERE.parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-import blender_addon  # noqa: E402
-from blender_addon import engine as tesela_engine  # noqa: E402
 from test_addon import result_pixels  # noqa: E402
 
 SIZE = 64
@@ -38,16 +36,6 @@ BLOCK_TOL = 0.05
 HDRI_W, HDRI_H = 128, 64
 SUN_COL, SUN_ROW = 40, 47      # column from the left, row from the bottom (Blender's rows)
 SUN_RADIANCE = 300.0
-
-
-@pytest.fixture(scope="module")
-def addon():
-    registered = tesela_engine.TeselaRenderEngine.is_registered
-    if not registered:
-        blender_addon.register()
-    yield
-    if not registered and tesela_engine.TeselaRenderEngine.is_registered:
-        blender_addon.unregister()
 
 
 def hdri():
