@@ -20,7 +20,6 @@ import pytest
 import imgcompare
 import scenes
 from test_addon import result_pixels
-from test_addon_cycles import addon  # noqa: F401  (the fixture)
 
 SIZE = 64
 
