@@ -28,6 +28,10 @@ fn srgb_table() -> &'static [f32; 256] {
 #[inline]
 pub fn wrap(i: i64, n: u32, mode: Wrap) -> usize {
     let n = n as i64;
+    if (0..n).contains(&i) {
+        // Every mode leaves an index inside the image alone; skip their divisions.
+        return i as usize;
+    }
     let r = match mode {
         Wrap::Repeat => i.rem_euclid(n),
         Wrap::ClampToEdge => i.clamp(0, n - 1),
