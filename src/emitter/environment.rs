@@ -88,8 +88,12 @@ pub struct Distribution2D {
     func: Vec<f32>,
     /// Per row, the normalised CDF over its columns (`w + 1` entries; all zero for an empty row).
     conditional: Vec<f32>,
+    /// Per row, the guide table of its CDF ([`guide_into`], `w + 1` entries).
+    conditional_guide: Vec<u32>,
     /// The normalised CDF over rows (`h + 1` entries).
     marginal: Vec<f32>,
+    /// The guide table of `marginal` (`h + 1` entries).
+    marginal_guide: Vec<u32>,
     /// `w h / Σ func`: a cell's value times this is the density on `[0, 1]²`.
     norm: f32,
 }
@@ -113,12 +117,35 @@ fn cdf_into(f: impl Iterator<Item = f64>, out: &mut Vec<f32>) -> f64 {
     acc
 }
 
-/// Samples cell and position within a CDF: `(cell, continuous coordinate in [0, 1))`.
+/// The guide bucket of a value in `[0, 1]` among `g` equal buckets; non-decreasing in `x`.
 #[inline]
-fn sample_cdf(cdf: &[f32], u: f32) -> (usize, f32) {
+fn bucket(x: f32, g: usize) -> usize {
+    ((x * g as f32) as usize).min(g - 1)
+}
+
+/// Appends the guide table of `cdf` with `g` buckets: entry `b` (of `g + 1`) is the first index
+/// whose value falls in bucket `b` or later (`cdf.len()` if none). Since [`bucket`] is
+/// monotone, the first entry above any `u` lies between the guides of `u`'s bucket and the
+/// next one, so a search confined there finds exactly what a search of the whole CDF finds.
+fn guide_into(cdf: &[f32], g: usize, out: &mut Vec<u32>) {
+    let mut i = 0;
+    for b in 0..=g {
+        while i < cdf.len() && bucket(cdf[i], g) < b {
+            i += 1;
+        }
+        out.push(i as u32);
+    }
+}
+
+/// Samples cell and position within a CDF with its guide table: `(cell, continuous
+/// coordinate in [0, 1))`.
+#[inline]
+fn sample_cdf(cdf: &[f32], guide: &[u32], u: f32) -> (usize, f32) {
     let n = cdf.len() - 1;
+    let b = bucket(u, guide.len() - 1);
+    let (lo, hi) = (guide[b] as usize, guide[b + 1] as usize);
     // The first entry above u, minus one: a cell of positive width containing u.
-    let i = cdf.partition_point(|&c| c <= u).clamp(1, n) - 1;
+    let i = (lo + cdf[lo..hi].partition_point(|&c| c <= u)).clamp(1, n) - 1;
     let (a, b) = (cdf[i], cdf[i + 1]);
     let du = if b > a {
         ((u - a) / (b - a)).clamp(0.0, 1.0)
@@ -151,12 +178,20 @@ impl Distribution2D {
         if !(total > 0.0 && total.is_finite()) {
             return None;
         }
+        let mut conditional_guide = Vec::with_capacity((w + 1) * h);
+        for row in conditional.chunks_exact(w + 1) {
+            guide_into(row, w, &mut conditional_guide);
+        }
+        let mut marginal_guide = Vec::with_capacity(h + 1);
+        guide_into(&marginal, h, &mut marginal_guide);
         Some(Distribution2D {
             w,
             h,
             func,
             conditional,
+            conditional_guide,
             marginal,
+            marginal_guide,
             norm: ((w * h) as f64 / total) as f32,
         })
     }
@@ -164,9 +199,13 @@ impl Distribution2D {
     /// A point of `[0, 1)²` and its density.
     #[inline]
     pub fn sample(&self, u: Vec2) -> (Vec2, f32) {
-        let (j, t) = sample_cdf(&self.marginal, u.y);
-        let row = &self.conditional[j * (self.w + 1)..(j + 1) * (self.w + 1)];
-        let (i, x) = sample_cdf(row, u.x);
+        let (j, t) = sample_cdf(&self.marginal, &self.marginal_guide, u.y);
+        let rows = j * (self.w + 1)..(j + 1) * (self.w + 1);
+        let (i, x) = sample_cdf(
+            &self.conditional[rows.clone()],
+            &self.conditional_guide[rows],
+            u.x,
+        );
         (Vec2::new(x, t), self.func[j * self.w + i] * self.norm)
     }
 
@@ -331,14 +370,23 @@ impl Environment {
 impl Emitter for Environment {
     fn sample(&self, scene: &Scene, rec: &mut EmitterQueryRecord, u: Vec2) -> Vec3 {
         rec.dist = f32::INFINITY;
-        rec.wi = match &self.dist {
+        (rec.wi, rec.pdf) = match &self.dist {
             Some(dist) => {
-                let (p, _) = dist.sample(u);
-                cell_direction(p.x, p.y)
+                // The density the point was drawn with, over the map's Jacobian `2π² sin θ`
+                // `pdf_dir` of the direction without going back through atan2 to find its cell.
+                let (p, density) = dist.sample(u);
+                let wi = cell_direction(p.x, p.y);
+                let b = to_blender(wi);
+                let sin_theta = (b.x * b.x + b.y * b.y).sqrt();
+                let pdf = if sin_theta > 0.0 {
+                    density / (2.0 * PI * PI * sin_theta)
+                } else {
+                    0.0
+                };
+                (wi, pdf)
             }
-            None => square_to_uniform_sphere(u),
+            None => (square_to_uniform_sphere(u), square_to_uniform_sphere_pdf()),
         };
-        rec.pdf = self.pdf_dir(rec.wi);
         if !(rec.pdf > 0.0 && rec.pdf.is_finite()) {
             rec.pdf = 0.0;
             return Vec3::ZERO;
@@ -465,6 +513,49 @@ mod tests {
             let cell = (p.x * 4.0) as usize;
             assert!(cell == 1 || cell == 3, "{p}");
             assert_eq!(pdf, 2.0);
+        }
+    }
+
+    #[test]
+    fn guided_search_finds_what_the_whole_search_finds() {
+        // CDFs with empty cells, runs of equal values, a spike and a dense tail; queries on a
+        // fine sweep plus every CDF value and its float neighbours (bucket edges included).
+        let mut state = 0x2545_f491_u32;
+        let mut rnd = || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state as f32 / u32::MAX as f32
+        };
+        for (n, g) in [(1usize, 1usize), (7, 7), (64, 64), (300, 64), (33, 100)] {
+            let f: Vec<f64> = (0..n)
+                .map(|i| match i % 5 {
+                    0 => 0.0,
+                    1 => 1e3 * rnd() as f64,
+                    _ => rnd() as f64,
+                })
+                .collect();
+            let mut cdf = Vec::new();
+            if cdf_into(f.iter().copied(), &mut cdf) == 0.0 {
+                continue;
+            }
+            let mut guide = Vec::new();
+            guide_into(&cdf, g, &mut guide);
+            let mut queries: Vec<f32> = (0..4096).map(|k| k as f32 / 4096.0).collect();
+            for &c in &cdf {
+                queries.extend([
+                    c,
+                    f32::from_bits(c.to_bits().saturating_sub(1)),
+                    c.next_up(),
+                ]);
+            }
+            for b in 0..=g {
+                queries.push(b as f32 / g as f32);
+            }
+            for u in queries.into_iter().filter(|u| (0.0..1.0).contains(u)) {
+                let whole = cdf.partition_point(|&c| c <= u).clamp(1, n) - 1;
+                assert_eq!(sample_cdf(&cdf, &guide, u).0, whole, "n {n} g {g} u {u}");
+            }
         }
     }
 
