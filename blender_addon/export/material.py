@@ -505,6 +505,12 @@ class MaterialGraph:
             props["source_colorspace"] = image.colorspace_settings.name
             props["alpha_mode"] = getattr(image, "alpha_mode", "STRAIGHT")
 
+    def _props_normal(self, node, props):
+        # The Normal node keeps its direction as its output's value.
+        out = node.outputs.get("Normal") if hasattr(node.outputs, "get") else node.outputs[0]
+        if out is not None and hasattr(out, "default_value"):
+            props["direction"] = self._floats(out.default_value, node, "direction")
+
     def _props_texcoord(self, node, props):
         ob = getattr(node, "object", None)
         if ob is not None:
@@ -593,6 +599,7 @@ _SPECIAL_PROPS = {
     "ShaderNodeFloatCurve": MaterialGraph._props_curves,
     "ShaderNodeRGB": MaterialGraph._props_constant,
     "ShaderNodeValue": MaterialGraph._props_constant,
+    "ShaderNodeNormal": MaterialGraph._props_normal,
 }
 
 

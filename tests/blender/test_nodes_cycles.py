@@ -939,6 +939,76 @@ case("emission-layer_weight-facing", lambda g: g.out(g.new("ShaderNodeLayerWeigh
 case("emission-geometry-normal-backfaces", coord("Normal", GEO), geometry=facets, offset=1.0)
 
 
+# -- Vector Rotate, Vector Transform, Normal, Camera Data, Tangent ---------------------------
+
+def rotate_case(kind, invert):
+    def build(g):
+        v = g.vec([(1.0, 0.0, 0.1), (0.0, 1.0, -0.2), (0.5, 0.5, 0.25)])
+        ins = dict(Vector=v, Center=(0.2, -0.1, 0.3))
+        if kind == "AXIS_ANGLE":
+            ins["Axis"] = (0.3, 0.5, 0.8)
+        if kind == "EULER_XYZ":
+            ins["Rotation"] = (0.4, -0.7, 1.1)
+        else:
+            ins["Angle"] = g.lin(0.5, 0.3, 0.7)
+        return g.out(g.new("ShaderNodeVectorRotate", {"rotation_type": kind, "invert": invert},
+                           **ins), "Vector")
+    return build
+
+
+for kind in ("AXIS_ANGLE", "X_AXIS", "Y_AXIS", "Z_AXIS", "EULER_XYZ"):
+    for invert in (False, True):
+        case("vector_rotate-%s%s" % (kind.lower(), "-invert" if invert else ""),
+             rotate_case(kind, invert), offset=5.0)
+
+
+def transform_case(kind, src, dst):
+    def build(g):
+        v = g.vec([(1.0, 0.0, 0.1), (0.0, 1.0, -0.2), (0.5, 0.5, 0.25)], source="Position")
+        return g.out(g.new("ShaderNodeVectorTransform", {
+            "vector_type": kind, "convert_from": src, "convert_to": dst}, Vector=v), "Vector")
+    return build
+
+
+for kind in ("POINT", "VECTOR", "NORMAL"):
+    for src, dst in (("WORLD", "OBJECT"), ("OBJECT", "WORLD"), ("WORLD", "CAMERA"),
+                     ("CAMERA", "WORLD"), ("OBJECT", "CAMERA"), ("CAMERA", "OBJECT")):
+        case("vector_transform-%s-%s-%s" % (kind.lower(), src.lower(), dst.lower()),
+             transform_case(kind, src, dst), geometry=transformed_plane, offset=8.0)
+
+
+def normal_node(output):
+    def build(g):
+        n = g.new("ShaderNodeNormal", Normal=g.vec([(0.5, 0.0, 0.1), (0.0, 0.5, -0.2),
+                                                    (0.0, 0.0, 1.0)]))
+        n.outputs["Normal"].default_value = (0.3, -0.5, 0.8)
+        return g.out(n, output)
+    return build
+
+
+case("normal-normal", normal_node("Normal"), offset=1.0)
+case("normal-dot", normal_node("Dot"), offset=1.0)
+for output, scale, offset in (("View Vector", 0.5, 0.5), ("View Z Depth", 0.1, 0.2),
+                              ("View Distance", 0.1, 0.2)):
+    # (Orthographic, the plane's depth is the same everywhere: a flat reference tests nothing.)
+    for geom in ((plane, persp_plane) if output != "View Z Depth" else (persp_plane,)):
+        case("camera_data-%s-%s" % (output.lower().replace(" ", "_"), geom.__name__),
+             coord(output, "ShaderNodeCameraData"), geometry=geom, scale=scale, offset=offset,
+             snapped=False, mode="diffuse")
+for axis in ("X", "Y", "Z"):
+    # The radial tangent is normalised, so a pixel's mean (64 spp over the pixel) is not its
+    # centre value where it turns quickly (measured: off by ~1e-3 over 2-5% of the dome, more
+    # at facet edges): judged by the fraction of pixels off; a wrong axis or sign is off nearly
+    # everywhere.
+    case("tangent-radial-%s" % axis.lower(),
+         coord("Tangent", "ShaderNodeTangent", {"direction_type": "RADIAL", "axis": axis}),
+         geometry=transformed_facets, scale=0.5, offset=0.5, mode="diffuse", snapped=False,
+         disc=True, frac=0.08)
+case("tangent-uv_map", coord("Tangent", "ShaderNodeTangent",
+                             {"direction_type": "UV_MAP", "uv_map": "UVMap"}),
+     geometry=transformed_plane, scale=0.5, offset=0.5, mode="diffuse", snapped=False)
+
+
 # -- Image Texture -----------------------------------------------------------------------------
 
 def make_image(kind):

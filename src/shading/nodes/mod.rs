@@ -14,6 +14,7 @@ pub mod math;
 pub mod mix;
 pub mod ramp;
 pub mod texture;
+pub mod transform;
 pub mod utility;
 pub mod vector;
 pub mod vector_math;
@@ -28,6 +29,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         texture::compile,
         utility::compile,
         vector::compile,
+        transform::compile,
         bump::compile,
         displacement::compile,
         convert::compile,
