@@ -54,6 +54,23 @@ mod tests {
     use super::*;
 
     #[test]
+    fn conductor_reduces_to_its_known_limits() {
+        // Normal incidence: ((n - 1)² + k²) / ((n + 1)² + k²); grazing: 1.
+        let (eta, k) = (Vec3::new(0.18, 0.42, 1.37), Vec3::new(3.42, 2.35, 1.77));
+        let f0 = conductor(1.0, eta, k);
+        let want = ((eta - Vec3::ONE) * (eta - Vec3::ONE) + k * k)
+            / ((eta + Vec3::ONE) * (eta + Vec3::ONE) + k * k);
+        assert!((f0 - want).abs().max_element() < 1e-6, "{f0} vs {want}");
+        assert!((conductor(0.0, eta, k) - Vec3::ONE).abs().max_element() < 1e-6);
+        // Without absorption it is the dielectric's reflectance at every angle.
+        for c in [0.05f32, 0.3, 0.7, 1.0] {
+            let d = dielectric(c, 1.7).0;
+            let r = conductor(c, Vec3::splat(1.7), Vec3::ZERO);
+            assert!((r.x - d).abs() < 1e-5, "cos {c}: {} vs {d}", r.x);
+        }
+    }
+
+    #[test]
     fn normal_incidence_matches_f0() {
         let (r, cos_t, _) = dielectric(1.0, 1.5);
         assert!((r - f0_from_ior(1.5)).abs() < 1e-6);
@@ -87,4 +104,28 @@ mod tests {
         }
         assert!(dielectric(1e-4, 1.5).0 > 0.99);
     }
+}
+
+/// Unpolarised Fresnel reflectance of a conductor of complex index `eta + i k` (relative to
+/// the outside medium, index 1) at `cos_i = cos θ` in `[0, 1]`, per channel: the mean of the
+/// s- and p-polarised reflectances.
+pub fn conductor(cos_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
+    let one = |eta: f32, k: f32| {
+        let c = cos_i.clamp(0.0, 1.0);
+        let (eta2, k2) = (eta * eta, k * k);
+        let t1 = eta2 - k2 - (1.0 - c * c);
+        let t2 = (t1 * t1 + 4.0 * eta2 * k2).sqrt();
+        let u2 = (0.5 * (t2 + t1)).max(0.0);
+        let v2 = (0.5 * (t2 - t1)).max(0.0);
+        let (u, v) = (u2.sqrt(), v2.sqrt());
+        let div = |a: f32, b: f32| if b > 0.0 { a / b } else { 0.0 };
+        let rs = div((c - u) * (c - u) + v2, (c + u) * (c + u) + v2);
+        let (t3, t4) = ((eta2 - k2) * c, 2.0 * eta * k * c);
+        let rp = div(
+            (t3 - u) * (t3 - u) + (t4 - v) * (t4 - v),
+            (t3 + u) * (t3 + u) + (t4 + v) * (t4 + v),
+        );
+        0.5 * (rs + rp)
+    };
+    Vec3::new(one(eta.x, k.x), one(eta.y, k.y), one(eta.z, k.z))
 }

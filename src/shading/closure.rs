@@ -37,6 +37,36 @@ pub struct Principled {
     pub cycles: bool,
 }
 
+impl Principled {
+    /// Every layer off (no base colour, specular, coat or sheen): a base for closures that
+    /// are one of Principled's lobes on its own (Metallic BSDF, Sheen BSDF).
+    pub fn lobe_only() -> Principled {
+        Principled {
+            base_color: Vec3::ZERO,
+            metallic: 0.0,
+            roughness: 0.5,
+            ior: 1.5,
+            specular_level: 0.0,
+            specular_tint: Vec3::ONE,
+            transmission: 0.0,
+            anisotropic: 0.0,
+            anisotropic_rotation: 0.0,
+            coat_weight: 0.0,
+            coat_roughness: 0.03,
+            coat_ior: 1.5,
+            coat_tint: Vec3::ONE,
+            coat_normal: Vec3::ZERO,
+            sheen_weight: 0.0,
+            sheen_roughness: 0.5,
+            sheen_tint: Vec3::ONE,
+            subsurface_weight: 0.0,
+            subsurface_radius: Vec3::ONE,
+            subsurface_scale: 0.0,
+            cycles: true,
+        }
+    }
+}
+
 /// One BSDF closure's kind and parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ClosureKind {

@@ -56,10 +56,35 @@ pub struct PrincipledSlots {
     cycles: bool,
 }
 
+/// How a Metallic BSDF gives its reflectance.
+#[derive(Clone, Copy, Debug)]
+pub enum MetalFresnel {
+    /// F82-tint: Base Color and Edge Tint.
+    F82 { base: Slot, tint: Slot },
+    /// A physical conductor: complex IOR `eta + i k` per channel.
+    Physical { ior: Slot, extinction: Slot },
+}
+
 /// A closure node's inputs.
 #[derive(Clone, Debug)]
 pub enum ClosureParams {
     Principled(Box<PrincipledSlots>),
+    /// Blender's Metallic BSDF: Cycles' F82 or physical conductor closure, which is the
+    /// Principled BSDF's metallic lobe.
+    Metallic {
+        fresnel: MetalFresnel,
+        roughness: Slot,
+        anisotropy: Slot,
+        rotation: Slot,
+        normal: Option<Slot>,
+        tangent: Option<Slot>,
+    },
+    /// Blender's Sheen BSDF (microfiber): the Principled BSDF's sheen lobe on its own.
+    Sheen {
+        color: Slot,
+        roughness: Slot,
+        normal: Option<Slot>,
+    },
     Diffuse {
         color: Slot,
         normal: Option<Slot>,
@@ -208,6 +233,56 @@ impl ClosureOp {
                     ClosureKind::Principled(pr),
                 );
             }
+            ClosureParams::Metallic {
+                fresnel,
+                roughness,
+                anisotropy,
+                rotation,
+                normal: n,
+                tangent: t,
+            } => {
+                let (base, tint) = match *fresnel {
+                    MetalFresnel::F82 { base, tint } => (col(base), col(tint)),
+                    MetalFresnel::Physical { ior, extinction } => {
+                        physical_as_f82(col(ior).max(Vec3::ZERO), col(extinction).max(Vec3::ZERO))
+                    }
+                };
+                let pr = Principled {
+                    base_color: base,
+                    metallic: 1.0,
+                    roughness: s.f(*roughness).clamp(0.0, 1.0),
+                    specular_tint: tint,
+                    anisotropic: s.f(*anisotropy).clamp(0.0, 1.0),
+                    anisotropic_rotation: s.f(*rotation),
+                    ..Principled::lobe_only()
+                };
+                push(
+                    out,
+                    Vec3::splat(w),
+                    normal(*n),
+                    tangent(*t),
+                    ClosureKind::Principled(pr),
+                );
+            }
+            ClosureParams::Sheen {
+                color,
+                roughness,
+                normal: n,
+            } => {
+                let pr = Principled {
+                    sheen_weight: 1.0,
+                    sheen_roughness: s.f(*roughness).clamp(0.0, 1.0),
+                    sheen_tint: col(*color),
+                    ..Principled::lobe_only()
+                };
+                push(
+                    out,
+                    Vec3::splat(w),
+                    normal(*n),
+                    Vec3::ZERO,
+                    ClosureKind::Principled(pr),
+                );
+            }
             ClosureParams::Diffuse { color, normal: n } => {
                 let c = col(*color);
                 push(
@@ -290,6 +365,18 @@ impl ClosureOp {
             ClosureParams::MixWeights { .. } => {}
         }
     }
+}
+
+/// A physical conductor's complex IOR as the F82-tint model's base colour and edge tint that
+/// reproduce its reflectance at normal incidence and at `cos θ = 1/7` (~82°) exactly, the fit
+/// Cycles itself uses for the conductor's multiple-scattering term.
+fn physical_as_f82(eta: Vec3, k: Vec3) -> (Vec3, Vec3) {
+    use crate::bsdf::fresnel;
+    let f0 = fresnel::conductor(1.0, eta, k);
+    let f82 = fresnel::conductor(1.0 / 7.0, eta, k);
+    let schlick = fresnel::schlick(f0, 1.0 / 7.0);
+    let tint = Vec3::select(schlick.cmpgt(Vec3::ZERO), f82 / schlick, Vec3::ONE);
+    (f0, tint)
 }
 
 /// A linked Normal input (Blender world space) as a unit world-space normal; zero (meaning
@@ -400,6 +487,50 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                 }
             }
             ClosureParams::Principled(Box::new(p))
+        }
+        "ShaderNodeBsdfMetallic" => {
+            let fresnel = if cx.prop_str("fresnel_type") == Some("PHYSICAL_CONDUCTOR") {
+                MetalFresnel::Physical {
+                    ior: cx.vector("IOR", Vec3::new(0.18, 0.42, 1.37))?,
+                    extinction: cx.vector("Extinction", Vec3::new(3.42, 2.35, 1.77))?,
+                }
+            } else {
+                MetalFresnel::F82 {
+                    base: cx.color("Base Color", Vec3::new(0.617, 0.577, 0.540))?,
+                    tint: cx.color("Edge Tint", Vec3::new(0.695, 0.726, 0.770))?,
+                }
+            };
+            match cx.prop_str("distribution").unwrap_or("MULTI_GGX") {
+                "MULTI_GGX" => {}
+                d => cx.warn(&format!(
+                    "distribution {d} renders as Multiscatter GGX (energy-conserving)"
+                )),
+            }
+            if cx.is_linked("Thin Film Thickness")
+                || cx
+                    .const_value("Thin Film Thickness")
+                    .is_some_and(|v| v[0] != 0.0)
+            {
+                cx.warn("thin film is not rendered");
+            }
+            ClosureParams::Metallic {
+                fresnel,
+                roughness: cx.float("Roughness", 0.5)?,
+                anisotropy: cx.float("Anisotropy", 0.0)?,
+                rotation: cx.float("Rotation", 0.0)?,
+                normal: normal(cx, "Normal")?,
+                tangent: normal(cx, "Tangent")?,
+            }
+        }
+        "ShaderNodeBsdfSheen" => {
+            if cx.prop_str("distribution").unwrap_or("MICROFIBER") != "MICROFIBER" {
+                cx.warn("the Ashikhmin sheen renders as Microfiber");
+            }
+            ClosureParams::Sheen {
+                color: cx.color("Color", Vec3::splat(0.8))?,
+                roughness: cx.float("Roughness", 0.5)?,
+                normal: normal(cx, "Normal")?,
+            }
         }
         "ShaderNodeBsdfDiffuse" => ClosureParams::Diffuse {
             color: cx.color("Color", Vec3::splat(0.8))?,
