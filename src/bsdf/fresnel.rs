@@ -49,6 +49,30 @@ pub fn f0_from_ior(eta: f32) -> f32 {
     r * r
 }
 
+/// Unpolarised Fresnel reflectance of a conductor of complex index `eta + i k` (relative to
+/// the outside medium, index 1) at `cos_i = cos θ` in `[0, 1]`, per channel: the mean of the
+/// s- and p-polarised reflectances.
+pub fn conductor(cos_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
+    let one = |eta: f32, k: f32| {
+        let c = cos_i.clamp(0.0, 1.0);
+        let (eta2, k2) = (eta * eta, k * k);
+        let t1 = eta2 - k2 - (1.0 - c * c);
+        let t2 = (t1 * t1 + 4.0 * eta2 * k2).sqrt();
+        let u2 = (0.5 * (t2 + t1)).max(0.0);
+        let v2 = (0.5 * (t2 - t1)).max(0.0);
+        let (u, v) = (u2.sqrt(), v2.sqrt());
+        let div = |a: f32, b: f32| if b > 0.0 { a / b } else { 0.0 };
+        let rs = div((c - u) * (c - u) + v2, (c + u) * (c + u) + v2);
+        let (t3, t4) = ((eta2 - k2) * c, 2.0 * eta * k * c);
+        let rp = div(
+            (t3 - u) * (t3 - u) + (t4 - v) * (t4 - v),
+            (t3 + u) * (t3 + u) + (t4 + v) * (t4 + v),
+        );
+        0.5 * (rs + rp)
+    };
+    Vec3::new(one(eta.x, k.x), one(eta.y, k.y), one(eta.z, k.z))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -104,28 +128,4 @@ mod tests {
         }
         assert!(dielectric(1e-4, 1.5).0 > 0.99);
     }
-}
-
-/// Unpolarised Fresnel reflectance of a conductor of complex index `eta + i k` (relative to
-/// the outside medium, index 1) at `cos_i = cos θ` in `[0, 1]`, per channel: the mean of the
-/// s- and p-polarised reflectances.
-pub fn conductor(cos_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
-    let one = |eta: f32, k: f32| {
-        let c = cos_i.clamp(0.0, 1.0);
-        let (eta2, k2) = (eta * eta, k * k);
-        let t1 = eta2 - k2 - (1.0 - c * c);
-        let t2 = (t1 * t1 + 4.0 * eta2 * k2).sqrt();
-        let u2 = (0.5 * (t2 + t1)).max(0.0);
-        let v2 = (0.5 * (t2 - t1)).max(0.0);
-        let (u, v) = (u2.sqrt(), v2.sqrt());
-        let div = |a: f32, b: f32| if b > 0.0 { a / b } else { 0.0 };
-        let rs = div((c - u) * (c - u) + v2, (c + u) * (c + u) + v2);
-        let (t3, t4) = ((eta2 - k2) * c, 2.0 * eta * k * c);
-        let rp = div(
-            (t3 - u) * (t3 - u) + (t4 - v) * (t4 - v),
-            (t3 + u) * (t3 + u) + (t4 + v) * (t4 + v),
-        );
-        0.5 * (rs + rp)
-    };
-    Vec3::new(one(eta.x, k.x), one(eta.y, k.y), one(eta.z, k.z))
 }
