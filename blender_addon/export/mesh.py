@@ -15,6 +15,21 @@ from .common import ExportCancelled
 MESHLIKE = {"MESH", "CURVE", "SURFACE", "FONT", "META", "CURVES_LEGACY"}
 
 
+def geometry_key(obj):
+    """What identifies an evaluated object's geometry within one depsgraph.
+
+    Mesh objects that share a mesh datablock and have no modifiers (Alt+D duplicates) share one
+    evaluated mesh: their evaluated obj.data is the same datablock, measured in Blender 3.4 and
+    5.0, so the data alone is the key and the mesh is exported once. With modifiers every object
+    evaluates its own mesh (a distinct obj.data, measured too), and other types (curves, text)
+    build their mesh per object: the object's name stays part of their key."""
+    data = obj.data
+    ptr = data.as_pointer() if data is not None else 0
+    if obj.type == "MESH" and len(obj.modifiers) == 0:
+        return ("mesh", ptr)
+    return ("object", obj.name, ptr)
+
+
 class MeshData:
     """The arrays of one evaluated mesh, ready for the buffer."""
 
