@@ -15,7 +15,7 @@ from .images import ImageTable, Textures
 from .instances import collapse
 from .light import convert_light
 from .material import DEFAULT_MATERIAL, MaterialReport, export_material
-from .mesh import MESHLIKE, geometry_key, mesh_arrays, object_extras
+from .mesh import MESHLIKE, geometry_key, mesh_arrays, object_extras, read_mesh
 from .world import convert_world
 
 
@@ -40,9 +40,16 @@ class Geometry:
         self.triangles = triangles
         self.texspace = texspace
 
+    def moved(self, first):
+        """The same geometry with its accessors numbered from `first` (a buffer file's
+        accessors appended to a document)."""
+        return Geometry({k: a + first for k, a in self.attributes.items()}, self.extras,
+                        [(slot, a + first) for slot, a in self.slots], self.triangles,
+                        self.texspace)
+
 
 def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settings=None,
-               check_cancel=None, selection=None):
+               check_cancel=None, selection=None, mesh_store=None):
     """Write the evaluated scene of `depsgraph` to `filepath` (.gltf) + a .bin beside it.
 
     width/height: the final render resolution (percentage applied).
@@ -50,6 +57,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     render_settings: dict for the TESELA_render extension, or None.
     check_cancel: callable returning True to abort (raises ExportCancelled).
     selection: optional set of original object names to restrict the export.
+    mesh_store: a MeshStore whose folder holds `filepath`: the meshes' buffers go to its files,
+    one per mesh content, written only where no earlier export wrote them (animations).
     """
     res = ExportResult()
     warnings = res.warnings
@@ -68,6 +77,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     images = ImageTable(buf, report)
     geometry_cache = {}  # geometry key -> Geometry, or None without triangles
     mesh_cache = {}  # (geometry key, glTF materials) -> (mesh index, triangles, texspace)
+    store_files = {}  # mesh store digest -> its first accessor here
     object_cache = {}  # (object name, data) -> the mesh_cache entry
     mesh_nodes = {}  # glTF mesh index -> nodes placing it
     khr_lights = []
@@ -93,24 +103,48 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
         root_nodes.append(len(doc["nodes"]) - 1)
 
     def add_geometry(obj, mesh, n_slots, tangent_uvs, texture_without_uv):
-        """The buffer data of an evaluated mesh: its vertex attributes and one index accessor
-        per material slot its triangles use."""
-        data = mesh_arrays(mesh, check_cancel, tangent_uvs, warnings.append, obj.name)
+        """The Geometry of an evaluated mesh: its data in this export's buffer, or, with a
+        mesh store, in the store's file for its content (written unless a frame before wrote
+        it)."""
+        raw = read_mesh(mesh, check_cancel)
+        if raw is None:
+            return None
+        if mesh_store is None:
+            return build_geometry(buf, obj, mesh, raw, n_slots, tangent_uvs, texture_without_uv,
+                                  warnings.append)
+        digest = raw.digest(sorted(tangent_uvs), texture_without_uv, n_slots)
+        stored = mesh_store.get(digest)
+        if stored is None:
+            own, found = Buffer(), []
+            geometry = build_geometry(own, obj, mesh, raw, n_slots, tangent_uvs,
+                                      texture_without_uv, found.append)
+            if geometry is None:
+                return None
+            stored = mesh_store.put(digest, own, geometry, found)
+        if digest not in store_files:  # the same content twice in one frame: one buffer
+            warnings.extend(stored.warnings)
+            store_files[digest] = buf.add_file(stored.uri, stored.byte_length, stored.views,
+                                               stored.accessors)
+        return stored.geometry.moved(store_files[digest])
+
+    def build_geometry(into, obj, mesh, raw, n_slots, tangent_uvs, texture_without_uv, warn):
+        """Convert the mesh and add its accessors to the Buffer `into`."""
+        data = mesh_arrays(mesh, check_cancel, tangent_uvs, warn, obj.name, raw=raw)
         if data is None:
             return None
-        attrs = {"POSITION": buf.add(data.positions, FLOAT, "VEC3", ARRAY_BUFFER, True),
-                 "NORMAL": buf.add(data.normals, FLOAT, "VEC3", ARRAY_BUFFER)}
+        attrs = {"POSITION": into.add(data.positions, FLOAT, "VEC3", ARRAY_BUFFER, True),
+                 "NORMAL": into.add(data.normals, FLOAT, "VEC3", ARRAY_BUFFER)}
         for i, (_, uv) in enumerate(data.uv_sets):
-            attrs["TEXCOORD_%d" % i] = buf.add(uv, FLOAT, "VEC2", ARRAY_BUFFER)
+            attrs["TEXCOORD_%d" % i] = into.add(uv, FLOAT, "VEC2", ARRAY_BUFFER)
         if not data.uv_sets and texture_without_uv:
             # No UV map: Cycles reads UV (0, 0) everywhere; so does the fallback texture.
             uv = np.zeros((data.positions.shape[0], 2), dtype=np.float32)
             uv[:, 1] = 1.0
-            attrs["TEXCOORD_0"] = buf.add(uv, FLOAT, "VEC2", ARRAY_BUFFER)
+            attrs["TEXCOORD_0"] = into.add(uv, FLOAT, "VEC2", ARRAY_BUFFER)
         for i, (_, col) in enumerate(data.color_sets):
-            attrs["COLOR_%d" % i] = buf.add(col, FLOAT, "VEC4", ARRAY_BUFFER)
+            attrs["COLOR_%d" % i] = into.add(col, FLOAT, "VEC4", ARRAY_BUFFER)
         if data.tangents is not None:
-            attrs["TANGENT"] = buf.add(data.tangents, FLOAT, "VEC4", ARRAY_BUFFER)
+            attrs["TANGENT"] = into.add(data.tangents, FLOAT, "VEC4", ARRAY_BUFFER)
         extras = {"tesela_uv_names": [n for n, _ in data.uv_sets],
                   "tesela_color_names": [n for n, _ in data.color_sets]}
         if data.tangent_uv is not None:
@@ -121,7 +155,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
         single = tri_mat.min() == tri_mat.max()
         for mi in ([tri_mat[0]] if single else np.unique(tri_mat)):
             sel = indices if single else indices[tri_mat == mi]
-            slots.append((int(mi), buf.add(sel.reshape(-1), UINT, "SCALAR", ELEMENT_ARRAY_BUFFER, True)))
+            slots.append((int(mi), into.add(sel.reshape(-1), UINT, "SCALAR", ELEMENT_ARRAY_BUFFER,
+                                            True)))
         return Geometry(attrs, extras, slots, int(indices.shape[0]), data.texspace)
 
     def add_mesh(obj, geometry, mat_ids):
@@ -268,11 +303,13 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     base = os.path.splitext(os.path.basename(filepath))[0]
     bin_name = base + ".bin"
     bin_path = os.path.join(os.path.dirname(os.path.abspath(filepath)), bin_name)
-    if buf.length:
-        from urllib.parse import quote
-        doc["buffers"] = [{"uri": quote(bin_name), "byteLength": buf.length}]
+    from urllib.parse import quote
+    buffers = buf.gltf_buffers(quote(bin_name))
+    if buffers is not None:
+        doc["buffers"] = buffers
         doc["bufferViews"] = buf.views
         doc["accessors"] = buf.accessors
+    if buf.length:
         with open(bin_path, "wb") as f:
             for chunk in buf.chunks:
                 f.write(chunk)
