@@ -72,7 +72,11 @@ class MeshStore:
 
     def end_render(self):
         """Remove the render's own files (its .gltf, .bin, textures), keeping the meshes."""
-        for name in os.listdir(self.folder):
+        try:
+            names = os.listdir(self.folder)
+        except OSError:  # the job ended first (closed)
+            return
+        for name in names:
             if name == SUBDIR:
                 continue
             path = os.path.join(self.folder, name)

@@ -107,3 +107,35 @@ def test_static_meshes_are_written_once_per_animation(addon, tesela_bin, tmp_pat
         single = imgcompare.read_exr(tmp_path / ("single_%d_.exr" % f))
         assert np.array_equal(single, frames[f - 1]), "frame %d: cached == full export" % f
     assert our_tmpdirs() == before
+
+
+def test_the_store_forgets_meshes_two_frames_unused(tmp_path):
+    """A mesh no render of the current or the previous frame used is removed with its file; the
+    frame's own files go after each render, the folder at the job's end."""
+    from blender_addon.export.buffer import FLOAT, Buffer
+    from blender_addon.export.mesh_store import MeshStore
+
+    store = MeshStore(str(tmp_path / "job"))
+
+    def put(digest):
+        b = Buffer()
+        b.add(np.zeros((3, 3), dtype=np.float32), FLOAT, "VEC3", None)
+        return store.put(digest, b, None, [])
+
+    store.begin_render(1)
+    a, b = put("a"), put("b")
+    (tmp_path / "job" / "scene.gltf").write_text("{}")
+    store.end_render()
+    assert sorted(os.listdir(tmp_path / "job")) == ["meshes"]
+    store.begin_render(2)
+    assert store.get("a") is a and (store.written, store.reused) == (0, 1)
+    store.begin_render(3)  # b: unused by frame 2, but frame 1 was the one before
+    assert store.get("b") is b
+    store.begin_render(4)
+    store.begin_render(5)  # a: unused by frames 3 and 4; b used by 3
+    assert os.listdir(tmp_path / "job" / "meshes") == ["b.bin"]
+    assert store.get("a") is None
+    store.begin_render(6)
+    assert os.listdir(tmp_path / "job" / "meshes") == []
+    store.close()
+    assert not (tmp_path / "job").exists()
