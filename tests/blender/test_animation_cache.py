@@ -51,7 +51,7 @@ def animated_camera_scene(tmp_path):
     if hasattr(s, "media_type"):
         s.media_type = "IMAGE"
     s.file_format, s.color_mode, s.color_depth = "OPEN_EXR", "RGBA", "32"
-    r.filepath = str(tmp_path / "frame_####")
+    r.filepath, r.use_file_extension = str(tmp_path / "frame_####"), True
     t = scene.tesela
     t.integrator, t.samples, t.max_depth, t.seed = "direct_mis", 4, 2, 3
     t.threads = 2
@@ -64,7 +64,8 @@ def restored_scene():
     scene = bpy.context.scene
     r, s = scene.render, scene.render.image_settings
     saved = [(r, k, getattr(r, k)) for k in ("engine", "resolution_x", "resolution_y",
-                                             "resolution_percentage", "filepath")]
+                                             "resolution_percentage", "filepath",
+                                             "use_file_extension")]
     saved += [(s, k, getattr(s, k)) for k in ("file_format", "color_mode", "color_depth")]
     saved += [(scene, k, getattr(scene, k)) for k in ("frame_start", "frame_end", "frame_current")]
     yield

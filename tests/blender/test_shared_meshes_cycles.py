@@ -88,7 +88,11 @@ def test_object_linked_material_agrees_with_cycles(addon, tesela_bin, tmp_path, 
     scenes.tesela_like_cycles(t)
     t.integrator, t.samples, t.max_depth, t.seed = "direct_mis", spp, 2, 1
     t.threads = int(os.environ.get("TESELA_TEST_THREADS", "0"))
-    assert bpy.ops.render.render() == {"FINISHED"}
+    try:
+        assert bpy.ops.render.render() == {"FINISHED"}
+    finally:  # the scene outlives the module: later tests expect the default settings
+        for k in ("integrator", "samples", "max_depth", "seed", "threads"):
+            t.property_unset(k)
     got = result_pixels(tmp_path)
     result = imgcompare.compare(got, ref, mean_tol=0.02, block_tol=0.05)
     print(f"object-linked material: {result}")
