@@ -14,15 +14,15 @@ bl_info = {
 if "bpy" in locals():  # reload support (F3 > Reload Scripts)
     import importlib
     for _m in (compat, protocol, process, report, export, properties, preferences,  # noqa: F821
-               viewport, engine, ui):  # noqa: F821
+               render_jobs, viewport, engine, ui):  # noqa: F821
         importlib.reload(_m)
 
 import bpy  # noqa: E402
 
 from . import compat, protocol, process, report, export, properties, preferences  # noqa: E402,F401
-from . import viewport, engine, ui  # noqa: E402
+from . import render_jobs, viewport, engine, ui  # noqa: E402
 
-_MODULES = (properties, preferences, viewport, engine, ui)
+_MODULES = (properties, preferences, render_jobs, viewport, engine, ui)
 
 
 def register():

@@ -134,6 +134,38 @@ def corner_normals(mesh, n_loops):
     return out.reshape(-1, 3)
 
 
+def _int_attribute(mesh, name, domain):
+    attrs = getattr(mesh, "attributes", None)
+    a = attrs.get(name) if attrs is not None else None
+    return a if a is not None and a.domain == domain and a.data_type == "INT" else None
+
+
+def corner_verts(mesh, n_loops):
+    """The vertex of each corner, int32 (n_loops,). 4.0+ stores it as the attribute
+    .corner_vert, which foreach_get copies at once (about 500x faster than loops.vertex_index,
+    which goes corner by corner: 0.02 ms vs 9.8 ms for 61k corners in 5.0)."""
+    out = np.empty(n_loops, dtype=np.int32)
+    a = _int_attribute(mesh, ".corner_vert", "CORNER")
+    if a is not None:
+        a.data.foreach_get("value", out)
+    else:
+        mesh.loops.foreach_get("vertex_index", out)
+    return out
+
+
+def face_materials(mesh, n_polys):
+    """The material slot index of each face, int32 (n_polys,). 4.0+ (where corners are
+    attributes too) keeps it in the attribute material_index, absent when every face uses slot
+    0; before, polygons.material_index."""
+    out = np.zeros(n_polys, dtype=np.int32)
+    a = _int_attribute(mesh, "material_index", "FACE")
+    if a is not None:
+        a.data.foreach_get("value", out)
+    elif _int_attribute(mesh, ".corner_vert", "CORNER") is None:
+        mesh.polygons.foreach_get("material_index", out)
+    return out
+
+
 def vertex_positions(mesh, n_verts):
     out = np.empty(n_verts * 3, dtype=np.float32)
     mesh.vertices.foreach_get("co", out)

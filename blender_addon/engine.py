@@ -10,7 +10,7 @@ import time
 import bpy
 import numpy as np
 
-from . import compat, export, passes, preferences, protocol, report, viewport
+from . import compat, export, passes, preferences, protocol, render_jobs, report, viewport
 from .process import StderrTail, _describe_exit, make_tmpdir, stop_process, sweep_stale_tmpdirs
 
 POLL_SECONDS = 0.03        # how often render() looks at the queue and test_break()
@@ -22,6 +22,7 @@ class RenderSession:
 
     def __init__(self):
         self.tmpdir = None
+        self.store = None  # the job's MeshStore when tmpdir is its folder
         self.proc = None
         self.reader = None
         self.stderr = None
@@ -50,9 +51,12 @@ class RenderSession:
                         pipe.close()
                 except OSError:
                     pass
-        if self.tmpdir is not None:
+        if self.store is not None:
+            self.store.end_render()  # the folder and its meshes stay for the job's next frame
+            self.store = None
+        elif self.tmpdir is not None:
             shutil.rmtree(self.tmpdir, ignore_errors=True)
-            self.tmpdir = None
+        self.tmpdir = None
         return code
 
 
@@ -257,7 +261,12 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
     def _render(self, depsgraph, scene, settings, width, height, region, rw, rh, session):
         self.update_stats("", "Tesela | Exporting scene")
         sweep_stale_tmpdirs()
-        session.tmpdir = make_tmpdir()
+        store = None if self.is_preview else render_jobs.current_store()
+        if store is not None:
+            store.begin_render(scene.frame_current)
+            session.store, session.tmpdir = store, store.folder
+        else:
+            session.tmpdir = make_tmpdir()
         gltf = os.path.join(session.tmpdir, "scene.gltf")
         camera = getattr(self, "camera_override", None) or scene.camera
         if camera is None:
@@ -269,9 +278,14 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
         t0 = time.monotonic()
         try:
             res = export.write_gltf(depsgraph, gltf, width=width, height=height, camera=camera,
-                                    render_settings=render_settings, check_cancel=self.should_stop)
+                                    render_settings=render_settings, check_cancel=self.should_stop,
+                                    mesh_store=store)
         except export.ExportCancelled:
             return
+        if store is not None:
+            print("Tesela: frame %d: meshes written %d, reused %d (export %.2f s)" % (
+                scene.frame_current, store.written, store.reused, time.monotonic() - t0),
+                flush=True)
         session.fallbacks = report.FallbackReport()
         session.fallbacks.add_addon_all(res.material_warnings)
         for w in res.warnings[:20]:

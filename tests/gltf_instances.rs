@@ -245,3 +245,52 @@ fn trailing_indices_of_triangles_are_dropped_with_a_warning() {
         s.warnings
     );
 }
+
+#[test]
+fn meshes_sharing_accessors_with_other_materials_are_one_geometry() {
+    // Meshes 0 and 1 name the same accessors with different materials (Blender objects sharing
+    // a mesh with object-linked materials); mesh 2 has its own positions.
+    let mut d = doc(
+        json!([
+            { "mesh": 0, "translation": [0.0, 0.0, -1.0] },
+            { "mesh": 1, "translation": [2.0, 0.0, -1.0] },
+            { "mesh": 2, "translation": [4.0, 0.0, -1.0] }
+        ]),
+        &[0, 1, 2],
+        &[("VEC3", vec![0., 0., 0., 2., 0., 0., 0., 2., 0.])],
+    );
+    d["scenes"][0]["nodes"] = json!([0, 1, 2]);
+    let prim = |m: usize, pos: usize| json!({ "primitives": [{ "attributes": { "POSITION": pos }, "indices": 0, "material": m }] });
+    d["meshes"] = json!([prim(0, 1), prim(1, 1), prim(0, 2)]);
+    d["materials"] = json!([
+        { "name": "red", "pbrMetallicRoughness": { "baseColorFactor": [1.0, 0.0, 0.0, 1.0] } },
+        { "name": "blue", "pbrMetallicRoughness": { "baseColorFactor": [0.0, 0.0, 1.0, 1.0] } }
+    ]);
+    let s = load(&d);
+    // Meshes 0 and 1: one stored geometry and two instances; mesh 2, placed once, is baked.
+    assert_eq!(
+        s.meshes.len(),
+        2,
+        "{:?}",
+        s.meshes.iter().map(|m| &m.name).collect::<Vec<_>>()
+    );
+    assert_eq!(s.instances.len(), 2);
+    assert_eq!(s.instances[0].mesh, s.instances[1].mesh);
+    let stored = &s.meshes[s.instances[0].mesh];
+    let material = |i: &tesela::scene::Instance| i.material.unwrap_or(stored.material);
+    let names: Vec<&str> = s
+        .instances
+        .iter()
+        .map(|i| s.materials[material(i)].name.as_str())
+        .collect();
+    assert_eq!(names, ["red", "blue"]);
+    assert!((s.instances[1].to_world.w_axis.x - 2.0).abs() < 1e-6);
+    let baked = s
+        .meshes
+        .iter()
+        .find(|m| m.positions.len() == 3 && m.positions[1].x > 5.0);
+    assert!(
+        baked.is_some(),
+        "mesh 2 baked at x = 4 with its own positions"
+    );
+}

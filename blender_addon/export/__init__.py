@@ -11,10 +11,12 @@ and the fallback PNGs), light, world, camera; gltf assembles the document, buffe
 
 if "gltf" in locals():  # reload support (F3 > Reload Scripts): submodules first
     import importlib
-    for _m in (common, buffer, images, material, mesh, light, camera, world, gltf):  # noqa: F821
+    for _m in (common, buffer, images, material, mesh, mesh_store, light, camera, world,  # noqa: F821
+               gltf):  # noqa: F821
         importlib.reload(_m)
 
-from . import common, buffer, images, material, mesh, light, camera, world, gltf  # noqa: E402,F401
+from . import common, buffer, images, material, mesh, mesh_store, light, camera, world  # noqa: E402,F401
+from . import gltf  # noqa: E402,F401
 from .buffer import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT, UINT, Buffer  # noqa: E402,F401
 from .camera import camera_extension, camera_fields, camera_matrix  # noqa: E402,F401
 from .common import ExportCancelled, color3, finite, gltf_matrix, matrix  # noqa: E402,F401
@@ -23,5 +25,6 @@ from .images import ImageTable, Textures, write_png  # noqa: E402,F401
 from .light import convert_light  # noqa: E402,F401
 from .material import (DEFAULT_MATERIAL, MaterialGraph, MaterialReport,  # noqa: E402,F401
                        convert_material, export_material)
-from .mesh import MESHLIKE, mesh_arrays, object_extras, random_id  # noqa: E402,F401
+from .mesh import MESHLIKE, mesh_arrays, object_extras, random_id, read_mesh  # noqa: E402,F401
+from .mesh_store import MeshStore  # noqa: E402,F401
 from .world import convert_world  # noqa: E402,F401

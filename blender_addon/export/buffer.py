@@ -1,5 +1,7 @@
 # SPDX-License-Identifier: MIT
-"""The binary buffer of one export: data chunks plus the bufferViews/accessors describing them."""
+"""The binary buffers of one export: buffer 0's data chunks (the .bin beside the .gltf), buffers
+already written to files of their own (the mesh store's), and the bufferViews/accessors
+describing both."""
 
 import numpy as np
 
@@ -15,6 +17,29 @@ class Buffer:
         self.length = 0
         self.views = []
         self.accessors = []
+        self.files = []  # [(uri relative to the .gltf, byteLength)]: buffers 1, 2, ...
+
+    def add_file(self, uri, byte_length, views, accessors):
+        """Reference a buffer file whose own bufferViews (buffer 0, offsets into the file) and
+        accessors (indexing those views) are `views` and `accessors`, as another Buffer built
+        them. Returns the index of its first accessor here: its accessor k is first + k."""
+        self.files.append((uri, byte_length))
+        index, first_view, first = len(self.files), len(self.views), len(self.accessors)
+        self.views.extend(dict(v, buffer=index) for v in views)
+        self.accessors.extend(dict(a, bufferView=a["bufferView"] + first_view) for a in accessors)
+        return first
+
+    def gltf_buffers(self, bin_uri):
+        """The document's `buffers` (buffer 0 at `bin_uri`), renumbering the views when buffer 0
+        is empty (glTF forbids empty buffers), or None without data."""
+        buffers = [{"uri": uri, "byteLength": n} for uri, n in self.files]
+        if self.length:
+            return [{"uri": bin_uri, "byteLength": self.length}] + buffers
+        if not buffers:
+            return None
+        for v in self.views:
+            v["buffer"] -= 1
+        return buffers
 
     def add_view(self, raw, target=None):
         """Append raw bytes (4-byte aligned) as a bufferView; returns its index."""

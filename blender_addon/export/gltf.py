@@ -15,7 +15,7 @@ from .images import ImageTable, Textures
 from .instances import collapse
 from .light import convert_light
 from .material import DEFAULT_MATERIAL, MaterialReport, export_material
-from .mesh import MESHLIKE, mesh_arrays, object_extras
+from .mesh import MESHLIKE, geometry_key, mesh_arrays, object_extras, read_mesh
 from .world import convert_world
 
 
@@ -30,8 +30,26 @@ class ExportResult:
         self.instanced_nodes = 0  # nodes folded into EXT_mesh_gpu_instancing
 
 
+class Geometry:
+    """The accessors of one evaluated mesh, shared by every glTF mesh that places it."""
+
+    def __init__(self, attributes, extras, slots, triangles, texspace):
+        self.attributes = attributes  # glTF attribute name -> accessor
+        self.extras = extras          # the primitives' extras (UV and colour names)
+        self.slots = slots            # [(material slot, index accessor)]
+        self.triangles = triangles
+        self.texspace = texspace
+
+    def moved(self, first):
+        """The same geometry with its accessors numbered from `first` (a buffer file's
+        accessors appended to a document)."""
+        return Geometry({k: a + first for k, a in self.attributes.items()}, self.extras,
+                        [(slot, a + first) for slot, a in self.slots], self.triangles,
+                        self.texspace)
+
+
 def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settings=None,
-               check_cancel=None, selection=None):
+               check_cancel=None, selection=None, mesh_store=None):
     """Write the evaluated scene of `depsgraph` to `filepath` (.gltf) + a .bin beside it.
 
     width/height: the final render resolution (percentage applied).
@@ -39,6 +57,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     render_settings: dict for the TESELA_render extension, or None.
     check_cancel: callable returning True to abort (raises ExportCancelled).
     selection: optional set of original object names to restrict the export.
+    mesh_store: a MeshStore whose folder holds `filepath`: the meshes' buffers go to its files,
+    one per mesh content, written only where no earlier export wrote them (animations).
     """
     res = ExportResult()
     warnings = res.warnings
@@ -55,7 +75,10 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     textures = Textures(out_dir, stem, warnings)
     report = MaterialReport(warnings, res.material_warnings)
     images = ImageTable(buf, report)
-    mesh_cache = {}
+    geometry_cache = {}  # geometry key -> Geometry, or None without triangles
+    mesh_cache = {}  # (geometry key, glTF materials) -> (mesh index, triangles, texspace)
+    store_files = {}  # mesh store digest -> its first accessor here
+    object_cache = {}  # (object name, data) -> the mesh_cache entry
     mesh_nodes = {}  # glTF mesh index -> nodes placing it
     khr_lights = []
 
@@ -79,44 +102,112 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
         doc["nodes"].append(node)
         root_nodes.append(len(doc["nodes"]) - 1)
 
-    def add_mesh(obj, mesh):
-        mats = [s.material for s in obj.material_slots] or [None]
-        infos = [mat_idx(m) for m in mats]
-        mat_ids = [i for i, _ in infos]
-        tangent_uvs = set().union(*(t for _, t in infos))
-        data = mesh_arrays(mesh, check_cancel, tangent_uvs, warnings.append, obj.name)
+    def add_geometry(obj, mesh, n_slots, tangent_uvs, texture_without_uv):
+        """The Geometry of an evaluated mesh: its data in this export's buffer, or, with a
+        mesh store, in the store's file for its content (written unless a frame before wrote
+        it)."""
+        raw = read_mesh(mesh, check_cancel)
+        if raw is None:
+            return None
+        if mesh_store is None:
+            return build_geometry(buf, obj, mesh, raw, n_slots, tangent_uvs, texture_without_uv,
+                                  warnings.append)
+        digest = raw.digest(sorted(tangent_uvs), texture_without_uv, n_slots)
+        stored = mesh_store.get(digest)
+        if stored is None:
+            own, found = Buffer(), []
+            geometry = build_geometry(own, obj, mesh, raw, n_slots, tangent_uvs,
+                                      texture_without_uv, found.append)
+            if geometry is None:
+                return None
+            stored = mesh_store.put(digest, own, geometry, found)
+        if digest not in store_files:  # the same content twice in one frame: one buffer
+            warnings.extend(stored.warnings)
+            store_files[digest] = buf.add_file(stored.uri, stored.byte_length, stored.views,
+                                               stored.accessors)
+        return stored.geometry.moved(store_files[digest])
+
+    def build_geometry(into, obj, mesh, raw, n_slots, tangent_uvs, texture_without_uv, warn):
+        """Convert the mesh and add its accessors to the Buffer `into`."""
+        data = mesh_arrays(mesh, check_cancel, tangent_uvs, warn, obj.name, raw=raw)
         if data is None:
             return None
-        attrs = {"POSITION": buf.add(data.positions, FLOAT, "VEC3", ARRAY_BUFFER, True),
-                 "NORMAL": buf.add(data.normals, FLOAT, "VEC3", ARRAY_BUFFER)}
+        attrs = {"POSITION": into.add(data.positions, FLOAT, "VEC3", ARRAY_BUFFER, True),
+                 "NORMAL": into.add(data.normals, FLOAT, "VEC3", ARRAY_BUFFER)}
         for i, (_, uv) in enumerate(data.uv_sets):
-            attrs["TEXCOORD_%d" % i] = buf.add(uv, FLOAT, "VEC2", ARRAY_BUFFER)
-        if not data.uv_sets and any("baseColorTexture" in doc["materials"][i]["pbrMetallicRoughness"]
-                                    for i in mat_ids):
+            attrs["TEXCOORD_%d" % i] = into.add(uv, FLOAT, "VEC2", ARRAY_BUFFER)
+        if not data.uv_sets and texture_without_uv:
             # No UV map: Cycles reads UV (0, 0) everywhere; so does the fallback texture.
             uv = np.zeros((data.positions.shape[0], 2), dtype=np.float32)
             uv[:, 1] = 1.0
-            attrs["TEXCOORD_0"] = buf.add(uv, FLOAT, "VEC2", ARRAY_BUFFER)
+            attrs["TEXCOORD_0"] = into.add(uv, FLOAT, "VEC2", ARRAY_BUFFER)
         for i, (_, col) in enumerate(data.color_sets):
-            attrs["COLOR_%d" % i] = buf.add(col, FLOAT, "VEC4", ARRAY_BUFFER)
+            attrs["COLOR_%d" % i] = into.add(col, FLOAT, "VEC4", ARRAY_BUFFER)
         if data.tangents is not None:
-            attrs["TANGENT"] = buf.add(data.tangents, FLOAT, "VEC4", ARRAY_BUFFER)
+            attrs["TANGENT"] = into.add(data.tangents, FLOAT, "VEC4", ARRAY_BUFFER)
         extras = {"tesela_uv_names": [n for n, _ in data.uv_sets],
                   "tesela_color_names": [n for n, _ in data.color_sets]}
         if data.tangent_uv is not None:
             extras["tesela_tangent_uv"] = data.tangent_uv
-        tri_mat = np.clip(data.tri_material, 0, len(mats) - 1)
+        tri_mat = np.clip(data.tri_material, 0, n_slots - 1)
         indices = data.indices
-        prims = []
+        slots = []
         single = tri_mat.min() == tri_mat.max()
         for mi in ([tri_mat[0]] if single else np.unique(tri_mat)):
             sel = indices if single else indices[tri_mat == mi]
-            acc = buf.add(sel.reshape(-1), UINT, "SCALAR", ELEMENT_ARRAY_BUFFER, True)
-            prims.append({"attributes": attrs, "indices": acc, "mode": 4,
-                          "material": mat_ids[int(mi)], "extras": extras})
-        doc["meshes"].append({"name": obj.name, "primitives": prims})
-        return (len(doc["meshes"]) - 1, int(indices.shape[0]), data.texspace)
+            slots.append((int(mi), into.add(sel.reshape(-1), UINT, "SCALAR", ELEMENT_ARRAY_BUFFER,
+                                            True)))
+        return Geometry(attrs, extras, slots, int(indices.shape[0]), data.texspace)
 
+    def add_mesh(obj, geometry, mat_ids):
+        """A glTF mesh of `geometry` with the object's materials: objects that share a mesh
+        but not its materials get meshes naming the same accessors."""
+        prims = [{"attributes": geometry.attributes, "indices": acc, "mode": 4,
+                  "material": mat_ids[slot], "extras": geometry.extras}
+                 for slot, acc in geometry.slots]
+        doc["meshes"].append({"name": obj.name, "primitives": prims})
+        return (len(doc["meshes"]) - 1, geometry.triangles, geometry.texspace)
+
+    def object_mesh(obj):
+        """(glTF mesh index, triangles, texture space) of a mesh-like object, or None when it
+        has no triangles."""
+        # The instances of one object (collections, Geometry Nodes) repeat its name and data:
+        # they skip the material lookups.
+        okey = (obj.name, obj.data.as_pointer() if obj.data is not None else 0)
+        if okey not in object_cache:
+            object_cache[okey] = shared_mesh(obj)
+        return object_cache[okey]
+
+    def shared_mesh(obj):
+        mats = [s.material for s in obj.material_slots] or [None]
+        infos = [mat_idx(m) for m in mats]
+        mat_ids = tuple(i for i, _ in infos)
+        tangent_uvs = frozenset().union(*(t for _, t in infos))
+        texture_without_uv = any("baseColorTexture" in doc["materials"][i]["pbrMetallicRoughness"]
+                                 for i in mat_ids)
+        gkey = (geometry_key(obj), tangent_uvs, texture_without_uv, len(mats))
+        key = (gkey, mat_ids)
+        if key in mesh_cache:
+            return mesh_cache[key]
+        if gkey not in geometry_cache:
+            if check_cancel is not None and check_cancel():
+                raise ExportCancelled()
+            geometry_cache[gkey] = None
+            try:
+                mesh = obj.to_mesh()
+            except RuntimeError:
+                mesh = None
+            if mesh is not None:
+                try:
+                    geometry_cache[gkey] = add_geometry(obj, mesh, len(mats), tangent_uvs,
+                                                        texture_without_uv)
+                finally:
+                    obj.to_mesh_clear()
+        geometry = geometry_cache[gkey]
+        mesh_cache[key] = None if geometry is None else add_mesh(obj, geometry, mat_ids)
+        return mesh_cache[key]
+
+    skipped_types = set()
     count = 0
     for inst in depsgraph.object_instances:
         count += 1
@@ -134,23 +225,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                 continue
         otype = obj.type
         if otype in MESHLIKE:
-            data = obj.data
-            key = (obj.name, data.as_pointer() if data is not None else 0)
-            if key not in mesh_cache:
-                if check_cancel is not None and check_cancel():
-                    raise ExportCancelled()
-                mesh_cache[key] = None
-                mesh = None
-                try:
-                    mesh = obj.to_mesh()
-                except RuntimeError:
-                    mesh = None
-                if mesh is not None:
-                    try:
-                        mesh_cache[key] = add_mesh(obj, mesh)
-                    finally:
-                        obj.to_mesh_clear()
-            cached = mesh_cache[key]
+            cached = object_mesh(obj)
             if cached is None:
                 continue
             if not compat.visible_camera(obj):
@@ -164,8 +239,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             add_node({"name": obj.name, "mesh": mi, "matrix": gltf_matrix(matrix(inst.matrix_world)),
                       "extras": extras})
         elif otype in ("CURVES", "POINTCLOUD", "VOLUME", "GPENCIL", "GREASEPENCIL"):
-            if ("skip", otype) not in mesh_cache:
-                mesh_cache[("skip", otype)] = None
+            if otype not in skipped_types:
+                skipped_types.add(otype)
                 warnings.append("%s objects are not supported; '%s' (and any others) left out"
                                 % (otype.lower(), obj.name))
         elif otype == "LIGHT":
@@ -228,11 +303,13 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     base = os.path.splitext(os.path.basename(filepath))[0]
     bin_name = base + ".bin"
     bin_path = os.path.join(os.path.dirname(os.path.abspath(filepath)), bin_name)
-    if buf.length:
-        from urllib.parse import quote
-        doc["buffers"] = [{"uri": quote(bin_name), "byteLength": buf.length}]
+    from urllib.parse import quote
+    buffers = buf.gltf_buffers(quote(bin_name))
+    if buffers is not None:
+        doc["buffers"] = buffers
         doc["bufferViews"] = buf.views
         doc["accessors"] = buf.accessors
+    if buf.length:
         with open(bin_path, "wb") as f:
             for chunk in buf.chunks:
                 f.write(chunk)

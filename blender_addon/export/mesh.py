@@ -7,12 +7,29 @@ corners), and MikkTSpace tangents (TANGENT) when a material needs them. Data sta
 space, in Blender's coordinates; the node matrices turn Z-up into Y-up.
 """
 
+import hashlib
+
 import numpy as np
 
 from .. import compat
 from .common import ExportCancelled
 
 MESHLIKE = {"MESH", "CURVE", "SURFACE", "FONT", "META", "CURVES_LEGACY"}
+
+
+def geometry_key(obj):
+    """What identifies an evaluated object's geometry within one depsgraph.
+
+    Mesh objects that share a mesh datablock and have no modifiers (Alt+D duplicates) share one
+    evaluated mesh: their evaluated obj.data is the same datablock, measured in Blender 3.4 and
+    5.0, so the data alone is the key and the mesh is exported once. With modifiers every object
+    evaluates its own mesh (a distinct obj.data, measured too), and other types (curves, text)
+    build their mesh per object: the object's name stays part of their key."""
+    data = obj.data
+    ptr = data.as_pointer() if data is not None else 0
+    if obj.type == "MESH" and len(obj.modifiers) == 0:
+        return ("mesh", ptr)
+    return ("object", obj.name, ptr)
 
 
 class MeshData:
@@ -34,33 +51,97 @@ class MeshData:
         return self.uv_sets[0][1] if self.uv_sets else None
 
 
-def mesh_arrays(mesh, check_cancel=None, tangent_uvs=None, warn=None, label=""):
+class RawMesh:
+    """What the glTF arrays of an evaluated mesh are computed from, as far as Blender copies it
+    at once (foreach_get on contiguous data): positions, topology, face materials, corner
+    normals, UV maps, colours, texture space. The loop triangles (which Blender copies
+    triangle by triangle, slowly) follow from these, so a digest of them is a digest of the
+    mesh's export."""
+
+    def __init__(self):
+        self.loop_vert = None    # int32 (n_loops,): each corner's vertex
+        self.loop_start = None   # int32 (n_polys,): each face's first corner
+        self.face_material = None  # int32 (n_polys,)
+        self.co = None           # float32 (n_verts, 3)
+        self.normals = None      # float32 (n_loops, 3), corner normals
+        self.uvs = []            # [(name, float32 (n_loops, 2))], the render map first
+        self.colors = []         # [(name, float32 (n_loops or n_verts, 4), domain)]
+        self.texspace = None     # (location, size)
+
+    def digest(self, *context):
+        """blake2b of every array and of `context` (what else the export depends on, e.g. the
+        UV maps the materials want tangents for), hex."""
+        h = hashlib.blake2b(digest_size=20)
+        for a in (self.loop_vert, self.loop_start, self.face_material, self.co, self.normals):
+            h.update(b"|%d|" % a.size)
+            h.update(np.ascontiguousarray(a).tobytes())
+        for name, a, *domain in self.uvs + self.colors:
+            h.update(repr((name, domain, a.size)).encode("utf-8"))
+            h.update(np.ascontiguousarray(a).tobytes())
+        h.update(repr((self.texspace, context)).encode("utf-8"))
+        return h.hexdigest()
+
+
+def read_mesh(mesh, check_cancel=None):
+    """The RawMesh of an evaluated mesh, or None if it has no faces."""
+    def checkpoint():
+        if check_cancel is not None and check_cancel():
+            raise ExportCancelled()
+    n_polys = len(mesh.polygons)
+    if n_polys == 0:
+        return None
+    raw = RawMesh()
+    n_loops = len(mesh.loops)
+    n_verts = len(mesh.vertices)
+    raw.loop_vert = compat.corner_verts(mesh, n_loops)
+    raw.loop_start = np.empty(n_polys, dtype=np.int32)
+    mesh.polygons.foreach_get("loop_start", raw.loop_start)
+    raw.face_material = compat.face_materials(mesh, n_polys)
+    raw.co = compat.vertex_positions(mesh, n_verts)
+    checkpoint()
+    raw.normals = compat.corner_normals(mesh, n_loops)
+    checkpoint()
+    for layer in compat.uv_layers(mesh):
+        raw.uvs.append((layer.name, compat.corner_uv(layer, n_loops)))
+    checkpoint()
+    for name, domain, data in compat.color_layers(mesh):
+        n = n_loops if domain == "CORNER" else n_verts
+        col = np.empty(n * 4, dtype=np.float32)
+        try:
+            data.foreach_get("color", col)
+        except (TypeError, RuntimeError, AttributeError):
+            continue
+        raw.colors.append((name, col.reshape(-1, 4), domain))
+    checkpoint()
+    raw.texspace = compat.texture_space(mesh)
+    return raw
+
+
+def mesh_arrays(mesh, check_cancel=None, tangent_uvs=None, warn=None, label="", raw=None):
     """MeshData for an evaluated mesh (None if it has no triangles).
 
     tangent_uvs: UV map names whose tangents the materials need ("" = the active render map);
-    warn(message): where problems go.
+    warn(message): where problems go; raw: the mesh's RawMesh if already read.
     """
     def checkpoint():
         if check_cancel is not None and check_cancel():
             raise ExportCancelled()
     warn = warn or (lambda message: None)
+    if raw is None:
+        raw = read_mesh(mesh, check_cancel)
+        if raw is None:
+            return None
     mesh.calc_loop_triangles()
     checkpoint()
     nt = len(mesh.loop_triangles)
     if nt == 0:
         return None
-    n_loops = len(mesh.loops)
-    n_verts = len(mesh.vertices)
     tri = np.empty(nt * 3, dtype=np.int32)
     mesh.loop_triangles.foreach_get("loops", tri)
     tri_mat = np.empty(nt, dtype=np.int32)
     mesh.loop_triangles.foreach_get("material_index", tri_mat)
-    loop_vert = np.empty(n_loops, dtype=np.int32)
-    mesh.loops.foreach_get("vertex_index", loop_vert)
-    co = compat.vertex_positions(mesh, n_verts)
-    checkpoint()
-    normals = compat.corner_normals(mesh, n_loops)
-    checkpoint()
+    loop_vert, co, normals = raw.loop_vert, raw.co, raw.normals
+    n_loops = loop_vert.shape[0]
 
     out = MeshData()
     # One glTF vertex per corner (face corner = Blender loop): loop triangles cover every
@@ -80,33 +161,25 @@ def mesh_arrays(mesh, check_cancel=None, tangent_uvs=None, warn=None, label=""):
     out.indices = tri.view(np.uint32).reshape(-1, 3)
     out.tri_material = tri_mat
 
-    layers = compat.uv_layers(mesh)
+    layers = raw.uvs
     blender_uvs = {}
-    for layer in layers:
-        uv = compat.corner_uv(layer, n_loops)
-        blender_uvs[layer.name] = uv
+    for name, uv in layers:
+        blender_uvs[name] = uv
         flipped = uv.copy()
         flipped[:, 1] = 1.0 - flipped[:, 1]  # glTF's UV origin is the top-left corner
-        out.uv_sets.append((layer.name, flipped))
-        checkpoint()
+        out.uv_sets.append((name, flipped))
+    checkpoint()
 
-    for name, domain, data in compat.color_layers(mesh):
-        n = n_loops if domain == "CORNER" else n_verts
-        col = np.empty(n * 4, dtype=np.float32)
-        try:
-            data.foreach_get("color", col)
-        except (TypeError, RuntimeError, AttributeError):
-            continue
-        col = col.reshape(-1, 4)
+    for name, col, domain in raw.colors:
         if domain != "CORNER":
             col = col[loop_vert]
         if not np.isfinite(col).all():
             col = np.nan_to_num(col, nan=0.0, posinf=0.0, neginf=0.0)
         out.color_sets.append((name, np.ascontiguousarray(col)))
-        checkpoint()
+    checkpoint()
 
     if tangent_uvs and layers:
-        names = sorted({(u or layers[0].name) for u in tangent_uvs})
+        names = sorted({(u or layers[0][0]) for u in tangent_uvs})
         known = [u for u in names if u in blender_uvs]
         for u in names:
             if u not in blender_uvs:
@@ -130,7 +203,7 @@ def mesh_arrays(mesh, check_cancel=None, tangent_uvs=None, warn=None, label=""):
     elif tangent_uvs:
         warn("mesh '%s' has no UV map for its normal map" % label)
 
-    out.texspace = compat.texture_space(mesh)
+    out.texspace = raw.texspace
     return out
 
 

@@ -2,7 +2,8 @@
 
     blender -b --factory-startup --addons tesela --python blender34_make_scene.py -- OUT.blend KIND W H SPP
 
-KIND: "simple" (plane, cube, point light) or "cornell" (tests/blender/scenes.py's Cornell box).
+KIND: "simple" (plane, cube, point light), "animcam" (simple, its camera moving over frames 1-3)
+or "cornell" (tests/blender/scenes.py's Cornell box).
 The render engine is set to TESELA, so the add-on must be enabled (--addons tesela with
 BLENDER_USER_SCRIPTS pointing at a folder holding addons/tesela).
 """
@@ -41,6 +42,10 @@ else:
     cam.rotation_euler = (math.radians(65), 0, 0)
     scene.collection.objects.link(cam)
     scene.camera = cam
+    if kind == "animcam":
+        for frame, x in ((1, -0.4), (3, 0.4)):
+            cam.location.x = x
+            cam.keyframe_insert("location", frame=frame)
 
 r = scene.render
 r.engine = "TESELA"

@@ -8,6 +8,7 @@ and enabled with --addons. Each Blender runs with a private TMPDIR so that lefto
 
 import json
 import os
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -136,6 +137,25 @@ def test_background_animation_no_leaks(env34):
     for r in runs:
         assert not Path("/proc/%d" % r["pid"]).exists()
     assert leftovers(tmp) == []
+
+
+def test_background_animation_writes_still_meshes_once(env34, tesela_bin):
+    """`-a` over 3 frames of a still scene with a moving camera, real renderer: frame 1 writes
+    the two meshes and the others reuse them (the log's per-frame counts), TMPDIR is empty
+    afterwards, and frame 3 equals a `-f 3` render (a job of its own: a full export) exactly."""
+    base, env = env34
+    blend = make_scene(base, env, "animcam.blend", kind="animcam", w=24, h=16, spp=4)
+    p, tmp, out = render_b(base, env, blend, tesela_bin, "animcam", ["-s", "1", "-e", "3", "-a"])
+    counts = re.findall(r"Tesela: frame (\d+): meshes written (\d+), reused (\d+)", p.stdout)
+    assert counts == [("1", "2", "0"), ("2", "0", "2"), ("3", "0", "2")], p.stdout[-3000:]
+    assert leftovers(tmp) == []
+    p3, tmp3, out3 = render_b(base, env, blend, tesela_bin, "animcam f3", ["-f", "3"])
+    assert re.findall(r"meshes written (\d+)", p3.stdout) == ["2"], p3.stdout[-3000:]
+    frames = [imgcompare.read_exr(str(out).replace("###", "%03d" % f) + ".exr") for f in (1, 3)]
+    single = imgcompare.read_exr(str(out3).replace("###", "003") + ".exr")
+    assert not np.array_equal(frames[0], frames[1]), "the camera moves"
+    assert np.array_equal(frames[1], single)
+    assert leftovers(tmp3) == []
 
 
 def f12(base, env, blend, binary, tag, extra_env=None, timeout=120, quit_after=None):

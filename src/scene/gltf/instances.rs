@@ -103,14 +103,20 @@ impl<'a> Loader<'a> {
         Ok((transforms, random))
     }
 
-    /// Turns the meshes the node walk found into scene meshes: baked where a mesh is placed
+    /// Turns the meshes the node walk found into scene meshes: baked where a geometry is placed
     /// once (or a node sets its own morph weights), else stored once and placed by instances.
+    /// Meshes that share a geometry (see [`Loader::geometries`]) share one stored copy; an
+    /// instance of a mesh other than the one stored carries its own materials.
     pub(crate) fn place_meshes(&mut self, uses: Vec<MeshUse>) -> Result<(), LoadError> {
+        let mut meshes: Vec<usize> = uses.iter().map(|u| u.mesh).collect();
+        meshes.sort_unstable();
+        meshes.dedup();
+        let geometry = self.geometries(&meshes)?;
         let mut placements: HashMap<usize, usize> = HashMap::new();
         let mut total = 0usize;
         for u in &uses {
             let n = u.gpu.len().max(1);
-            *placements.entry(u.mesh).or_default() += n;
+            *placements.entry(geometry[&u.mesh]).or_default() += n;
             total = total.saturating_add(n);
         }
         if total > MAX_INSTANCES {
@@ -119,23 +125,42 @@ impl<'a> Loader<'a> {
                 format!("the nodes place {total} meshes, beyond the limit of {MAX_INSTANCES}"),
             ));
         }
-        let mut stored: HashMap<usize, std::ops::Range<usize>> = HashMap::new();
+        // Geometry -> (the mesh stored for it, its scene meshes, their primitive indices).
+        type Stored = (usize, std::ops::Range<usize>, Vec<usize>);
+        let mut stored: HashMap<usize, Stored> = HashMap::new();
+        // Mesh -> the materials of the stored primitives, for meshes placed on another's copy.
+        let mut overrides: HashMap<usize, Vec<usize>> = HashMap::new();
         for u in uses {
             let own_weights = self.root.nodes[u.node].weights.is_some();
-            if u.gpu.is_empty() && (placements[&u.mesh] == 1 || own_weights) {
-                let baked = self.instance_mesh(u.node, u.mesh, u.world, false)?;
+            let g = geometry[&u.mesh];
+            if u.gpu.is_empty() && (placements[&g] == 1 || own_weights) {
+                let (baked, _) = self.instance_mesh(u.node, u.mesh, u.world, false)?;
                 let origins = &mut self.origins.mesh_node;
                 origins.resize(baked.start, None);
                 origins.resize(baked.end, Some(u.node));
                 continue;
             }
-            let range = match stored.get(&u.mesh) {
-                Some(r) => r.clone(),
+            let (owner, range, prims) = match stored.get(&g) {
+                Some(s) => s.clone(),
                 None => {
-                    let r = self.instance_mesh(u.node, u.mesh, Mat4::IDENTITY, true)?;
-                    stored.insert(u.mesh, r.clone());
-                    r
+                    let (r, p) = self.instance_mesh(u.node, u.mesh, Mat4::IDENTITY, true)?;
+                    stored.insert(g, (u.mesh, r.clone(), p.clone()));
+                    (u.mesh, r, p)
                 }
+            };
+            let materials: Option<Vec<usize>> = if owner == u.mesh {
+                None
+            } else if let Some(m) = overrides.get(&u.mesh) {
+                Some(m.clone())
+            } else {
+                let mut m = Vec::with_capacity(prims.len());
+                for &pi in &prims {
+                    let prim = &self.root.meshes[u.mesh].primitives[pi];
+                    // Same geometry: the primitive renders as the stored one does.
+                    m.push(self.primitive_material(prim)?.unwrap_or_default());
+                }
+                overrides.insert(u.mesh, m.clone());
+                Some(m)
             };
             let locals = if u.gpu.is_empty() {
                 vec![Mat4::IDENTITY]
@@ -167,12 +192,12 @@ impl<'a> Loader<'a> {
                         _ => instance_random(u.node, k),
                     };
                 }
-                for mesh in range.clone() {
+                for (k, mesh) in range.clone().enumerate() {
                     self.origins.instance_node.push(u.node);
                     self.scene.instances.push(Instance {
                         mesh,
                         to_world: world,
-                        material: None,
+                        material: materials.as_ref().map(|m| m[k]),
                         object: object.clone(),
                     });
                 }
@@ -187,6 +212,76 @@ impl<'a> Loader<'a> {
             }
         }
         Ok(())
+    }
+}
+
+impl<'a> Loader<'a> {
+    /// Geometry ids of the glTF meshes `meshes` (sorted, distinct): meshes whose primitives
+    /// are the same JSON apart from `material` (the same accessors, mode, morph targets and
+    /// extras) and whose materials read the same attributes are one geometry, stored once.
+    /// This is how a file gives objects that share a mesh their own materials. Other meshes
+    /// are each their own geometry.
+    pub(crate) fn geometries(
+        &mut self,
+        meshes: &[usize],
+    ) -> Result<HashMap<usize, usize>, LoadError> {
+        let mut by_json: HashMap<String, Vec<usize>> = HashMap::new();
+        for &mi in meshes {
+            by_json.entry(self.geometry_json(mi)).or_default().push(mi);
+        }
+        let mut groups: Vec<Vec<usize>> = by_json.into_values().collect();
+        groups.sort_unstable();
+        let mut ids = HashMap::new();
+        let mut next = 0usize;
+        for group in groups {
+            if group.len() == 1 {
+                ids.insert(group[0], next);
+                next += 1;
+                continue;
+            }
+            // The stored copy holds what its materials read: meshes share it only when theirs
+            // read the same.
+            let mut by_needs: Vec<(Vec<Option<super::mesh::Needs>>, usize)> = Vec::new();
+            for mi in group {
+                let mut needs = Vec::new();
+                for pi in 0..self.root.meshes[mi].primitives.len() {
+                    let prim = &self.root.meshes[mi].primitives[pi];
+                    let m = self.primitive_material(prim)?;
+                    needs.push(m.map(|m| super::mesh::needs(&self.scene.materials[m])));
+                }
+                let id = match by_needs.iter().find(|(n, _)| *n == needs) {
+                    Some((_, id)) => *id,
+                    None => {
+                        by_needs.push((needs, next));
+                        next += 1;
+                        next - 1
+                    }
+                };
+                ids.insert(mi, id);
+            }
+        }
+        Ok(ids)
+    }
+
+    /// Mesh `mi`'s primitives and morph weights as JSON, without their materials.
+    fn geometry_json(&self, mi: usize) -> String {
+        let mesh = self.raw_item("meshes", mi);
+        let prims: Vec<serde_json::Value> = member(mesh, "primitives")
+            .and_then(serde_json::Value::as_array)
+            .map(|a| {
+                a.iter()
+                    .map(|p| {
+                        let mut p = p.clone();
+                        if let Some(o) = p.as_object_mut() {
+                            o.remove("material");
+                        }
+                        p
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        let weights = member(mesh, "weights").cloned();
+        serde_json::json!([prims, weights]).to_string()
     }
 }
 

@@ -91,7 +91,7 @@ pub(crate) fn to_world(local: &LocalPrim, m: Mat4) -> Option<WorldPrim> {
 }
 
 /// What of a primitive's optional attributes its material reads (only that is stored).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, Hash)]
 pub(crate) struct Needs {
     /// Every UV and colour set and the file's TANGENT: node graphs read them by name.
     all: bool,
@@ -139,7 +139,7 @@ pub(crate) fn texture_slots(m: &Material) -> Vec<(&'static str, TexRef)> {
     v
 }
 
-fn needs(m: &Material) -> Needs {
+pub(crate) fn needs(m: &Material) -> Needs {
     if m.graph.is_some() {
         return Needs {
             all: true,
@@ -213,14 +213,15 @@ fn default_name(base: &str, k: usize) -> String {
 impl<'a> Loader<'a> {
     /// Bakes mesh `mi` of node `ni` into world space by `world`; with `object_space`, stores it
     /// in its own space instead (identity `world`, for instances to place). Returns the range
-    /// of [`crate::scene::Scene::meshes`] its primitives became.
+    /// of [`crate::scene::Scene::meshes`] its primitives became and, for each of those, the
+    /// index of the primitive it came from.
     pub(crate) fn instance_mesh(
         &mut self,
         ni: usize,
         mi: usize,
         world: Mat4,
         object_space: bool,
-    ) -> Result<std::ops::Range<usize>, LoadError> {
+    ) -> Result<(std::ops::Range<usize>, Vec<usize>), LoadError> {
         let first = self.scene.meshes.len();
         let root = self.root;
         let mesh = root.meshes.get(mi).ok_or_else(|| {
@@ -240,16 +241,7 @@ impl<'a> Loader<'a> {
         let mut prims: Vec<(usize, Rc<LocalPrim>, usize)> = Vec::new();
         for (pi, prim) in mesh.primitives.iter().enumerate() {
             let has = |s: Semantic| prim.attributes.contains_key(&Checked::Valid(s));
-            let renders = matches!(
-                prim.mode,
-                Checked::Valid(Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan)
-            ) && has(Semantic::Positions);
-            let material = if renders {
-                let vc = has(Semantic::Colors(0));
-                Some(self.material(prim.material.map(|m| m.value()), vc)?)
-            } else {
-                None
-            };
+            let material = self.primitive_material(prim)?;
             let needs = material
                 .map(|m| needs(&self.scene.materials[m]))
                 .unwrap_or_default();
@@ -287,8 +279,9 @@ impl<'a> Loader<'a> {
             prims.push((pi, local, material));
         }
         if prims.is_empty() {
-            return Ok(first..first);
+            return Ok((first..first, Vec::new()));
         }
+        let kept = prims.iter().map(|(pi, _, _)| *pi).collect();
         // Per-object data: the node's extras (written by the add-on) or what the file implies.
         let extras = member(self.raw_item("nodes", ni), "extras");
         let texspace = match extras.and_then(|e| member(e, "tesela_texspace")) {
@@ -377,7 +370,25 @@ impl<'a> Loader<'a> {
                 attrs,
             });
         }
-        Ok(first..self.scene.meshes.len())
+        Ok((first..self.scene.meshes.len(), kept))
+    }
+
+    /// The scene material of a primitive that renders (triangles with positions), else `None`.
+    pub(crate) fn primitive_material(
+        &mut self,
+        prim: &json::mesh::Primitive,
+    ) -> Result<Option<usize>, LoadError> {
+        let has = |s: Semantic| prim.attributes.contains_key(&Checked::Valid(s));
+        let renders = matches!(
+            prim.mode,
+            Checked::Valid(Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan)
+        ) && has(Semantic::Positions);
+        if !renders {
+            return Ok(None);
+        }
+        let vc = has(Semantic::Colors(0));
+        self.material(prim.material.map(|m| m.value()), vc)
+            .map(Some)
     }
 
     /// Object Info data of node `ni`: `extras.tesela_object` (Blender's world coordinates),
