@@ -10,9 +10,63 @@ from .. import compat
 from .common import color3, finite
 
 
+def _linked_node(sock):
+    """The node feeding input `sock` through any reroutes, or None."""
+    while sock is not None and sock.is_linked:
+        node = sock.links[0].from_node
+        if node.bl_idname != "NodeReroute":
+            return node
+        sock = node.inputs[0] if node.inputs else None
+    return None
+
+
+def node_emission(light, name, warn):
+    """The factor a light's node tree puts on its colour: Cycles multiplies the light's own
+    strength by what its shader emits. Emission's unlinked Color x Strength, and Light Falloff's
+    Quadratic (the physical falloff) into Strength; anything else renders with those unlinked
+    values and is reported."""
+    nt = light.node_tree if getattr(light, "use_nodes", False) else None
+    if nt is None:
+        return (1.0, 1.0, 1.0)
+    outs = [n for n in nt.nodes if n.bl_idname == "ShaderNodeOutputLight"]
+    out = next((n for n in outs if n.is_active_output), outs[0] if outs else None)
+    if out is None:
+        return (1.0, 1.0, 1.0)
+    node = _linked_node(out.inputs["Surface"])
+    if node is None:
+        warn("light '%s': its node tree's Light Output has no shader; the light is black" % name)
+        return (0.0, 0.0, 0.0)
+    if node.bl_idname != "ShaderNodeEmission" or node.mute:
+        warn("light '%s': node '%s' in its node tree is not rendered; the light emits its own "
+             "colour" % (name, node.name))
+        return (1.0, 1.0, 1.0)
+    color, strength = node.inputs["Color"], node.inputs["Strength"]
+    c = [finite(v) for v in color.default_value[:3]]
+    if color.is_linked:
+        warn("light '%s': a linked emission colour is not rendered; its unlinked value is used"
+             % name)
+    k = finite(strength.default_value)
+    src = _linked_node(strength)
+    if src is not None:
+        link = strength.links[0]
+        falloff = src.bl_idname == "ShaderNodeLightFalloff" and not src.mute
+        if (falloff and link.from_socket.identifier == "Quadratic"
+                and not src.inputs["Strength"].is_linked
+                and not src.inputs["Smooth"].is_linked
+                and src.inputs["Smooth"].default_value == 0.0):
+            k = finite(src.inputs["Strength"].default_value)
+        else:
+            warn("light '%s': emission strength from node '%s' (%s) is not rendered; %g is used"
+                 % (name, src.name, link.from_socket.name, k))
+    return tuple(v * k for v in c)
+
+
 def convert_light(light, obj, matrix=None, warnings=None):
     t = light.type
     color, scale = compat.light_color_and_scale(light)
+    factor = node_emission(light, obj.name, warnings.append if warnings is not None
+                           else (lambda _m: None))
+    color = [c * f for c, f in zip(color[:3], factor)]
     ext = {"type": t, "color": color3(color)}
     energy = finite(light.energy) * scale
     if t == "SUN":

@@ -84,6 +84,27 @@ def spot_radius_soft():
     return info
 
 
+def light_nodes():
+    """Lights with node trees: a spot whose Emission is coloured and scaled, and a point light
+    whose strength comes through Light Falloff's Quadratic output."""
+    info = _plane_with_box()
+    spot = scenes.add_spot_light("Spot", (0.2, -0.4, 2.2), (-0.3, 0.3, 0.0), 120.0,
+                                 math.radians(60.0), blend=0.3, radius=0.1)
+    spot.data.use_nodes = True
+    em = next(n for n in spot.data.node_tree.nodes if n.bl_idname == "ShaderNodeEmission")
+    em.inputs["Color"].default_value = (1.0, 0.55, 0.25, 1.0)
+    em.inputs["Strength"].default_value = 1.8
+    pt = scenes.add_point_light("Point", (-0.8, 1.2, 1.2), 40.0, radius=0.1)
+    pt.data.use_nodes = True
+    nt = pt.data.node_tree
+    em = next(n for n in nt.nodes if n.bl_idname == "ShaderNodeEmission")
+    em.inputs["Color"].default_value = (0.3, 0.6, 1.0, 1.0)
+    falloff = nt.nodes.new("ShaderNodeLightFalloff")
+    falloff.inputs["Strength"].default_value = 2.5
+    nt.links.new(falloff.outputs["Quadratic"], em.inputs["Strength"])
+    return info
+
+
 def sun_angle():
     """A 25° sun whose soft shadow of the box falls towards the camera."""
     info = scenes.light_over_plane("sun", sun_strength=3.0)
@@ -193,6 +214,7 @@ CASES = [
     ("spot_radius_blend_sphere", spot_radius_blend, 0, "direct_mis", 512),
     ("spot_radius_soft", spot_radius_soft, 0, "direct_mis", 512),
     ("sun_angle", sun_angle, 0, "direct_mis", 512),
+    ("light_node_trees", light_nodes, 0, "direct_mis", 512),
     ("lights_in_a_mirror", lights_seen_in_a_mirror, 1, "path_mis", 512),
     ("sun_in_a_mirror", sun_in_a_mirror, 1, "path_mis", 256),
     ("area_square_spread60", area_spread("SQUARE", 60.0), 0, "direct_mis", 512),
@@ -259,3 +281,29 @@ def test_light_fields_are_exported(addon, tmp_path):  # noqa: F811
     assert panel["visible_diffuse"] is False and panel["multiple_importance"] is False
     assert panel["cast_shadow"] is True and panel["visible_camera"] is False
     assert sun["angle"] == pytest.approx(math.radians(5.0)) and sun["visible_transmission"] is False
+
+
+def test_light_node_trees_are_read_or_reported(addon, tmp_path):  # noqa: F811
+    """A light's Emission Color x Strength scales its colour; what the renderer cannot read
+    from its node tree is reported, naming the light and the node."""
+    import json
+
+    from blender_addon import export
+
+    scenes.clear_scene()
+    ob = scenes.add_point_light("Lamp", (0, 0, 1), 10.0, radius=0.1)
+    ob.data.color = (1.0, 1.0, 0.5)
+    ob.data.use_nodes = True
+    nt = ob.data.node_tree
+    em = next(n for n in nt.nodes if n.bl_idname == "ShaderNodeEmission")
+    em.inputs["Color"].default_value = (0.5, 1.0, 1.0, 1.0)
+    em.inputs["Strength"].default_value = 3.0
+    tex = nt.nodes.new("ShaderNodeTexNoise")
+    nt.links.new(tex.outputs["Fac"], em.inputs["Strength"])
+    dg = bpy.context.evaluated_depsgraph_get()
+    path = tmp_path / "l.gltf"
+    res = export.write_gltf(dg, str(path), width=8, height=8)
+    doc = json.loads(path.read_text(encoding="utf-8"))
+    light = next(n["extensions"]["TESELA_light"] for n in doc["nodes"] if n["name"] == "Lamp")
+    assert light["color"] == pytest.approx([1.5, 3.0, 1.5])
+    assert any("light 'Lamp'" in w and tex.name in w for w in res.warnings), res.warnings
