@@ -172,6 +172,19 @@ impl<'a> ShaderGlobals<'a> {
         }
     }
 
+    /// The corners of the point's triangle, Blender world space, when on a mesh.
+    #[inline]
+    pub fn triangle(&self) -> Option<[Vec3; 3]> {
+        let m = self.mesh?;
+        let corners = m.corners(self.tri).map(|i| m.positions[i]);
+        Some(corners.map(|p| {
+            to_blender(match self.instance {
+                Some(i) => i.to_world.transform_point3(p),
+                None => p,
+            })
+        }))
+    }
+
     /// Renderer world (glTF axes) → object space, when on a mesh: the instance's inverse
     /// transform followed by the mesh's own world → object map.
     #[inline]

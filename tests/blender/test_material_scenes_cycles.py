@@ -532,6 +532,19 @@ def metallic_bsdf(fresnel):
     return build
 
 
+def wireframe_ball():
+    """Dark wires over a light diffuse ball by the Wireframe node (world size 0.03 m)."""
+    mat, nt, out = node_material("Wire")
+    wire = node(nt, "ShaderNodeWireframe", Size=0.03)
+    light = node(nt, "ShaderNodeBsdfDiffuse", Color=(0.8, 0.8, 0.75, 1.0))
+    dark = node(nt, "ShaderNodeBsdfDiffuse", Color=(0.05, 0.1, 0.4, 1.0))
+    mix = node(nt, "ShaderNodeMixShader", Fac=wire.outputs["Fac"])
+    nt.links.new(light.outputs[0], mix.inputs[1])
+    nt.links.new(dark.outputs[0], mix.inputs[2])
+    surface(nt, out, mix.outputs[0])
+    _sphere_stage(mat)
+
+
 def sheen_bsdf():
     """The Sheen BSDF added to a dark Diffuse: the fabric look."""
     mat, nt, out = node_material("Velvet")
@@ -614,6 +627,7 @@ CASES = [
     ("emission_image_room", emission_room, 3, 256, 2048),
     ("principled_coat", principled_variant("coat"), 0, 256, 1024),
     ("principled_sheen", principled_variant("sheen"), 0, 256, 1024),
+    ("wireframe_ball", wireframe_ball, 0, 128, 512),
     ("metallic_bsdf_f82_anisotropic", metallic_bsdf("F82"), 0, 256, 1024),
     ("metallic_bsdf_physical_conductor", metallic_bsdf("PHYSICAL_CONDUCTOR"), 0, 256, 1024),
     pytest.param(("sheen_bsdf_over_diffuse", sheen_bsdf, 0, 256, 1024),

@@ -18,6 +18,7 @@ pub mod transform;
 pub mod utility;
 pub mod vector;
 pub mod vector_math;
+pub mod wireframe;
 
 use super::compile::{CompileError, NodeCx};
 
@@ -30,6 +31,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         utility::compile,
         vector::compile,
         transform::compile,
+        wireframe::compile,
         bump::compile,
         displacement::compile,
         convert::compile,
