@@ -45,12 +45,37 @@ pub fn valid_specular_normal(ng: Vec3, wi: Vec3, n: Vec3) -> Vec3 {
 /// take local +X as their tangent: the caller builds the frame from [`Closure::tangent`].
 #[inline]
 pub fn from_closure(c: &Closure, u: f32) -> BsdfInstance {
+    from_closure_blurred(c, u, 0.0)
+}
+
+/// `alpha` raised to at least `blur`, as Cycles' `bsdf_microfacet_blur` raises each of a
+/// microfacet closure's GGX alphas (`alpha = max(blur, alpha)`, in alpha = roughness², not
+/// in Blender's roughness); `blur <= 0` leaves it untouched.
+#[inline]
+fn blurred(alpha: f32, blur: f32) -> f32 {
+    if blur > 0.0 { alpha.max(blur) } else { alpha }
+}
+
+/// Blender's roughness `r` (alpha = r²) raised so that its alpha is at least `blur`.
+#[inline]
+fn blurred_roughness(r: f32, blur: f32) -> f32 {
+    if blur > 0.0 { r.max(blur.sqrt()) } else { r }
+}
+
+/// [`from_closure`] with Cycles' Filter Glossy: every microfacet lobe (Glossy, Glass,
+/// Refraction; Principled's metal, specular, transmission and coat) has its GGX alphas raised
+/// to at least `blur` (0: none). A smooth lobe so raised becomes the rough one, as Cycles'
+/// near-zero-alpha GGX closure does; diffuse, translucent, sheen and transparent closures
+/// stay. Cycles finds a lobe's energy compensation when it sets the closure up, before the
+/// blur, so a lobe that was smooth gets none.
+#[inline]
+pub fn from_closure_blurred(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
     match &c.kind {
         ClosureKind::Principled(p) if !p.cycles => choose(
             &SurfaceParams {
                 base_color: p.base_color,
                 metallic: p.metallic,
-                roughness: p.roughness,
+                roughness: blurred_roughness(p.roughness, blur),
                 transmission: p.transmission,
                 ior: p.ior,
                 specular: 2.0 * p.specular_level,
@@ -58,7 +83,7 @@ pub fn from_closure(c: &Closure, u: f32) -> BsdfInstance {
             },
             u,
         ),
-        ClosureKind::Principled(p) => principled(p, u),
+        ClosureKind::Principled(p) => principled(p, u, blur),
         ClosureKind::Diffuse { color } => BsdfInstance::Diffuse(Diffuse::new(*color)),
         ClosureKind::Glossy {
             color,
@@ -68,12 +93,14 @@ pub fn from_closure(c: &Closure, u: f32) -> BsdfInstance {
             ..
         } => {
             let (ax, ay) = anisotropy::glossy(*roughness, *a);
+            let (bx, by) = (blurred(ax, blur), blurred(ay, blur));
             // Blender's Glossy BSDF has no Fresnel; its colour is in the closure's weight.
-            if ax.max(ay) < DELTA_ALPHA {
+            if bx.max(by) < DELTA_ALPHA {
                 BsdfInstance::Mirror(Mirror::new(*color))
             } else {
-                let l = RoughConductor::glossy(*color, ax, ay);
-                BsdfInstance::RoughConductor(if *multiscatter { l.multiscatter() } else { l })
+                let l = RoughConductor::glossy(*color, bx, by);
+                let ms = *multiscatter && ax.max(ay) >= DELTA_ALPHA;
+                BsdfInstance::RoughConductor(if ms { l.multiscatter() } else { l })
             }
         }
         ClosureKind::Glass {
@@ -83,13 +110,15 @@ pub fn from_closure(c: &Closure, u: f32) -> BsdfInstance {
             multiscatter,
         } => {
             let alpha = roughness * roughness;
-            if alpha < DELTA_ALPHA {
+            let b = blurred(alpha, blur);
+            if b < DELTA_ALPHA {
                 // The colour tints every path through the glass once (the closure weight).
                 let _ = color;
                 BsdfInstance::Dielectric(Dielectric::new(*ior, Vec3::ONE))
             } else {
-                let l = RoughDielectric::glass(Vec3::ONE, *ior, alpha);
-                BsdfInstance::RoughDielectric(if *multiscatter { l.multiscatter() } else { l })
+                let l = RoughDielectric::glass(Vec3::ONE, *ior, b);
+                let ms = *multiscatter && alpha >= DELTA_ALPHA;
+                BsdfInstance::RoughDielectric(if ms { l.multiscatter() } else { l })
             }
         }
         ClosureKind::Refraction {
@@ -98,7 +127,7 @@ pub fn from_closure(c: &Closure, u: f32) -> BsdfInstance {
             ior,
         } => {
             let _ = color;
-            let alpha = (roughness * roughness).max(DELTA_ALPHA);
+            let alpha = blurred(roughness * roughness, blur).max(DELTA_ALPHA);
             BsdfInstance::RoughDielectric(RoughDielectric::refraction(Vec3::ONE, *ior, alpha))
         }
         ClosureKind::Translucent { color } => BsdfInstance::Translucent(Translucent::new(*color)),
@@ -106,13 +135,18 @@ pub fn from_closure(c: &Closure, u: f32) -> BsdfInstance {
     }
 }
 
-/// [`from_closure`] for a ray that left a diffuse bounce with some caustics switched off
-/// (`off`: [`crate::integrator::light_paths::caustics`] bits), as Cycles' closure setup leaves
-/// them out: without reflective caustics no Glossy, no Principled metal, specular layer or
-/// coat; without refractive ones no Refraction and no Principled transmission; a Glass without
-/// either is left out (with one of them it stays whole: an approximation). `None`: nothing of
-/// the closure is left.
-pub fn from_closure_without_caustics(c: &Closure, u: f32, off: u8) -> Option<BsdfInstance> {
+/// [`from_closure_blurred`] for a ray that left a diffuse bounce with some caustics switched
+/// off (`off`: [`crate::integrator::light_paths::caustics`] bits), as Cycles' closure setup
+/// leaves them out: without reflective caustics no Glossy, no Principled metal, specular layer
+/// or coat; without refractive ones no Refraction and no Principled transmission; a Glass
+/// without either is left out (with one of them it stays whole: an approximation). `None`:
+/// nothing of the closure is left.
+pub fn from_closure_without_caustics(
+    c: &Closure,
+    u: f32,
+    off: u8,
+    blur: f32,
+) -> Option<BsdfInstance> {
     use crate::integrator::light_paths::caustics::{NO_REFLECTIVE, NO_REFRACTIVE};
     let (refl, refr) = (off & NO_REFLECTIVE != 0, off & NO_REFRACTIVE != 0);
     match &c.kind {
@@ -121,7 +155,7 @@ pub fn from_closure_without_caustics(c: &Closure, u: f32, off: u8) -> Option<Bsd
         ClosureKind::Glass { .. } if refl && refr => None,
         // Cycles keeps the glass's reflection.
         ClosureKind::Glass { roughness, ior, .. } if refr => {
-            let alpha = roughness * roughness;
+            let alpha = blurred(roughness * roughness, blur);
             Some(BsdfInstance::RoughDielectric(RoughDielectric::reflection(
                 Vec3::ONE,
                 *ior,
@@ -142,7 +176,7 @@ pub fn from_closure_without_caustics(c: &Closure, u: f32, off: u8) -> Option<Bsd
             if u < transmission {
                 if refr {
                     // Cycles keeps the transmission lobe's reflection (a refraction-less glass).
-                    let alpha = q.roughness.clamp(0.0, 1.0).powi(2);
+                    let alpha = blurred(q.roughness.clamp(0.0, 1.0).powi(2), blur);
                     return Some(BsdfInstance::RoughDielectric(
                         RoughDielectric::principled_specular(q.specular_tint, q.ior, alpha, alpha)
                             .multiscatter(),
@@ -158,33 +192,36 @@ pub fn from_closure_without_caustics(c: &Closure, u: f32, off: u8) -> Option<Bsd
                     return black;
                 }
             }
-            Some(principled(&q, u))
+            Some(principled(&q, u, blur))
         }
-        _ => Some(from_closure(c, u)),
+        _ => Some(from_closure_blurred(c, u, blur)),
     }
 }
 
 /// Blender's Principled BSDF (4.x/5.x): one of transmission, metal or the dielectric base is
 /// chosen with probability equal to its mixture weight; coat and sheen are layered on top.
-fn principled(p: &Principled, u: f32) -> BsdfInstance {
+/// Microfacet alphas are raised to at least `blur` ([`from_closure_blurred`]).
+fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
     let r = p.roughness.clamp(0.0, 1.0);
-    let alpha = r * r;
-    let (ax, ay) = anisotropy::principled(r, p.anisotropic);
+    let alpha0 = r * r;
+    let (ax0, ay0) = anisotropy::principled(r, p.anisotropic);
+    let alpha = blurred(alpha0, blur);
+    let (ax, ay) = (blurred(ax0, blur), blurred(ay0, blur));
+    // Energy compensation as set up before the blur: none for a lobe that was smooth.
+    let (ms, ms_aniso) = (alpha0 >= DELTA_ALPHA, ax0.max(ay0) >= DELTA_ALPHA);
     let metallic = p.metallic.clamp(0.0, 1.0);
     let transmission = p.transmission.clamp(0.0, 1.0) * (1.0 - metallic);
     let base = if u < transmission {
         if alpha < DELTA_ALPHA {
             BaseLobe::Dielectric(Dielectric::new(p.ior, p.base_color))
         } else {
-            BaseLobe::RoughDielectric(
-                RoughDielectric::principled_transmission(
-                    p.base_color,
-                    p.specular_tint,
-                    p.ior,
-                    alpha,
-                )
-                .multiscatter(),
-            )
+            let l = RoughDielectric::principled_transmission(
+                p.base_color,
+                p.specular_tint,
+                p.ior,
+                alpha,
+            );
+            BaseLobe::RoughDielectric(if ms { l.multiscatter() } else { l })
         }
     } else {
         let u2 = if transmission > 0.0 {
@@ -196,9 +233,8 @@ fn principled(p: &Principled, u: f32) -> BsdfInstance {
             if ax.max(ay) < DELTA_ALPHA {
                 BaseLobe::Mirror(Mirror::new(p.base_color))
             } else {
-                BaseLobe::RoughConductor(
-                    RoughConductor::f82(p.base_color, p.specular_tint, ax, ay).multiscatter(),
-                )
+                let l = RoughConductor::f82(p.base_color, p.specular_tint, ax, ay);
+                BaseLobe::RoughConductor(if ms_aniso { l.multiscatter() } else { l })
             }
         } else if p.specular_level * p.specular_tint.max_element() <= 0.0 {
             BaseLobe::Diffuse(Diffuse::new(p.base_color))
@@ -216,13 +252,19 @@ fn principled(p: &Principled, u: f32) -> BsdfInstance {
             let ior = principled_specular_ior(p.ior, p.specular_level);
             let specular = RoughDielectric::principled_specular(p.specular_tint, ior, ax, ay);
             BaseLobe::SpecularDiffuse(Layered::new(
-                specular.multiscatter(),
+                if ms_aniso {
+                    specular.multiscatter()
+                } else {
+                    specular
+                },
                 Diffuse::new(p.base_color),
             ))
         }
     };
-    let coat = (p.coat_weight > 0.0)
-        .then(|| Coat::new(p.coat_weight, p.coat_roughness, p.coat_ior, p.coat_tint));
+    let coat = (p.coat_weight > 0.0).then(|| {
+        let r = blurred_roughness(p.coat_roughness.clamp(0.0, 1.0), blur);
+        Coat::new(p.coat_weight, r, p.coat_ior, p.coat_tint)
+    });
     let sheen = (p.sheen_weight > 0.0 && p.sheen_tint.max_element() > 0.0)
         .then(|| Sheen::new(p.sheen_tint * p.sheen_weight, p.sheen_roughness));
     match (coat, sheen) {

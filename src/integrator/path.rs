@@ -1,6 +1,7 @@
 //! Unidirectional path tracing: `path_mats` (BSDF sampling only) and `path_mis` (emitter and
 //! BSDF sampling at every vertex, power heuristic). Russian roulette from vertex 4 on, on the
-//! throughput's **maximum** component, survival probability capped at 0.95.
+//! throughput's **maximum** component, survival probability capped at 0.95. Both apply
+//! Cycles' Filter Glossy ([`super::filter_glossy`]) when it is on.
 
 use super::light_paths::{BounceCount, LightPaths};
 use super::light_split::{ClassWeights, Sink, SplitsLight};
@@ -66,6 +67,9 @@ impl SplitsLight for PathMats {
         let mut transparent = 0;
         let (mut counts, mut end) = (BounceCount::default(), self.max_depth);
         ctx.no_caustics = self.paths.no_caustics();
+        // Least BSDF density of the path's non-delta bounces (Filter Glossy).
+        let mut min_ray_pdf = f32::INFINITY;
+        ctx.blur = 0.0;
         loop {
             let last = depth >= end;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
@@ -86,6 +90,9 @@ impl SplitsLight for PathMats {
             if depth >= end || !roulette(ctx, depth, &mut throughput) {
                 return l;
             }
+            if self.paths.filter_glossy.is_on() {
+                ctx.blur = self.paths.filter_glossy.roughness(min_ray_pdf);
+            }
             let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
                 return l;
             };
@@ -105,6 +112,9 @@ impl SplitsLight for PathMats {
             };
             if S::ACTIVE && depth == 1 {
                 weights = sp.class_weights_sampled(&rec);
+            }
+            if self.paths.filter_glossy.is_on() && rec.measure != Measure::Discrete {
+                min_ray_pdf = min_ray_pdf.min(rec.pdf);
             }
             throughput *= w;
             // `sample` left the new ray's Light Path bits in the context.
@@ -138,6 +148,9 @@ impl SplitsLight for PathMis {
         let mut bsdf_pdf = f32::INFINITY;
         let (mut counts, mut end) = (BounceCount::default(), self.max_depth);
         ctx.no_caustics = self.paths.no_caustics();
+        // Least BSDF density of the path's non-delta bounces (Filter Glossy).
+        let mut min_ray_pdf = f32::INFINITY;
+        ctx.blur = 0.0;
         loop {
             let last = depth >= end;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, bsdf_pdf);
@@ -161,6 +174,9 @@ impl SplitsLight for PathMis {
             };
             if depth >= end || !roulette(ctx, depth, &mut throughput) {
                 return l;
+            }
+            if self.paths.filter_glossy.is_on() {
+                ctx.blur = self.paths.filter_glossy.roughness(min_ray_pdf);
             }
             let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
                 return l;
@@ -199,6 +215,9 @@ impl SplitsLight for PathMis {
             } else {
                 rec.pdf
             };
+            if self.paths.filter_glossy.is_on() && rec.measure != Measure::Discrete {
+                min_ray_pdf = min_ray_pdf.min(rec.pdf);
+            }
             throughput *= w;
             // `sample` left the new ray's Light Path bits in the context.
             if counts.count(ctx.ray_flags, &self.paths) {
