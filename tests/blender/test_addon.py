@@ -313,6 +313,7 @@ def test_render_pixels_orientation_and_percentage(addon, fake, private_tmp, tmp_
     assert argv[argv.index("--spp") + 1] == "4" and argv[argv.index("--max-depth") + 1] == "4"
     assert argv[argv.index("--tile-size") + 1] == "32"  # the panel's default
     assert "--no-caustics-reflective" not in argv and "--no-caustics-refractive" not in argv
+    assert argv[argv.index("--blur-glossy") + 1] == "1.0"  # Cycles' default Filter Glossy
     assert "--region" not in argv
     assert run["bin_exists"] and run["has_camera"]
     assert os.listdir(private_tmp) == []
