@@ -308,9 +308,165 @@ fn unlayered(b: BaseLobe) -> BsdfInstance {
 
 #[cfg(test)]
 mod tests {
-    use super::valid_specular_normal;
+    use super::{from_closure, from_closure_blurred, valid_specular_normal};
+    use crate::bsdf::{BaseLobe, BsdfInstance, DielectricMode, Roughness, TopLobe};
     use crate::sampler::Sampler;
     use crate::sampling::square_to_uniform_sphere;
+    use crate::shading::{Closure, ClosureKind, Principled};
+    use glam::Vec3;
+
+    fn closure(kind: ClosureKind) -> Closure {
+        Closure {
+            weight: Vec3::ONE,
+            normal: Vec3::ZERO,
+            tangent: Vec3::ZERO,
+            surface_normal: Vec3::ZERO,
+            kind,
+        }
+    }
+
+    fn glossy(roughness: f32, anisotropy: f32) -> Closure {
+        closure(ClosureKind::Glossy {
+            color: Vec3::ONE,
+            roughness,
+            anisotropy,
+            rotation: 0.0,
+            multiscatter: true,
+        })
+    }
+
+    fn principled(metallic: f32, roughness: f32, coat_roughness: f32) -> Closure {
+        closure(ClosureKind::Principled(Principled {
+            base_color: Vec3::splat(0.8),
+            metallic,
+            roughness,
+            ior: 1.5,
+            specular_level: 0.5,
+            specular_tint: Vec3::ONE,
+            transmission: 0.0,
+            anisotropic: 0.0,
+            anisotropic_rotation: 0.0,
+            coat_weight: 1.0,
+            coat_roughness,
+            coat_ior: 1.5,
+            coat_tint: Vec3::ONE,
+            coat_normal: Vec3::ZERO,
+            sheen_weight: 0.0,
+            sheen_roughness: 0.5,
+            sheen_tint: Vec3::ONE,
+            subsurface_weight: 0.0,
+            subsurface_radius: Vec3::ONE,
+            subsurface_scale: 0.0,
+            cycles: true,
+        }))
+    }
+
+    fn conductor(b: BsdfInstance) -> (Roughness, bool) {
+        match b {
+            BsdfInstance::RoughConductor(l) => (l.roughness, l.multiscatter),
+            other => panic!("not a rough conductor: {other:?}"),
+        }
+    }
+
+    /// Cycles' `bsdf_microfacet_blur`: each GGX alpha becomes `max(blur, alpha)`; a smooth
+    /// lobe turns into the rough one without energy compensation, a lobe already rougher than
+    /// the blur is left as it was, and non-microfacet closures are untouched.
+    #[test]
+    fn filter_glossy_raises_each_alpha_to_the_blur() {
+        let b = 0.3;
+        assert_eq!(
+            conductor(from_closure_blurred(&glossy(0.0, 0.0), 0.5, b)),
+            (Roughness::new(b, b), false),
+            "a sharp Glossy"
+        );
+        // Roughness 0.8: alpha 0.64 > 0.3.
+        let rough = glossy(0.8, 0.0);
+        assert_eq!(
+            format!("{:?}", from_closure_blurred(&rough, 0.5, b)),
+            format!("{:?}", from_closure(&rough, 0.5))
+        );
+        // Roughness 0.4, anisotropy 0.5: alphas (0.08, 0.32); only the first is raised.
+        let (ax, ay) = super::anisotropy::glossy(0.4, 0.5);
+        assert!(ax < b && ay > b, "{ax} {ay}");
+        let (r, ms) = conductor(from_closure_blurred(&glossy(0.4, 0.5), 0.5, b));
+        assert_eq!((r.alpha_x, r.alpha_y, ms), (b, ay, true));
+        let glass = closure(ClosureKind::Glass {
+            color: Vec3::ONE,
+            roughness: 0.0,
+            ior: 1.5,
+            multiscatter: true,
+        });
+        match from_closure_blurred(&glass, 0.5, b) {
+            BsdfInstance::RoughDielectric(l) => {
+                assert_eq!(l.roughness, Roughness::new(b, b));
+                assert_eq!(l.mode, DielectricMode::Glass);
+                assert!(l.multiscatter_fss.is_none());
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(matches!(
+            from_closure(&glass, 0.5),
+            BsdfInstance::Dielectric(_)
+        ));
+        let refraction = closure(ClosureKind::Refraction {
+            color: Vec3::ONE,
+            roughness: 0.1,
+            ior: 1.5,
+        });
+        match from_closure_blurred(&refraction, 0.5, b) {
+            BsdfInstance::RoughDielectric(l) => assert_eq!(l.roughness, Roughness::new(b, b)),
+            other => panic!("{other:?}"),
+        }
+        let diffuse = closure(ClosureKind::Diffuse { color: Vec3::ONE });
+        assert_eq!(
+            format!("{:?}", from_closure_blurred(&diffuse, 0.5, b)),
+            format!("{:?}", from_closure(&diffuse, 0.5))
+        );
+    }
+
+    /// The Principled BSDF's metal and its coat are raised alike; the blur 0 builds exactly
+    /// what [`from_closure`] builds.
+    #[test]
+    fn filter_glossy_blurs_principled_lobes_and_zero_is_no_blur() {
+        let b = 0.25;
+        let p = principled(1.0, 0.0, 0.0);
+        let BsdfInstance::Layered(l) = from_closure_blurred(&p, 0.5, b) else {
+            panic!("a coated metal is layered");
+        };
+        let TopLobe::Coat(coat) = l.top else {
+            panic!("{:?}", l.top)
+        };
+        assert!((coat.alpha - b).abs() < 1e-6, "coat alpha {}", coat.alpha);
+        match l.base {
+            BaseLobe::RoughConductor(m) => {
+                assert_eq!(m.roughness, Roughness::new(b, b));
+                assert!(!m.multiscatter, "the smooth metal had no compensation");
+            }
+            other => panic!("{other:?}"),
+        }
+        for c in [
+            p,
+            principled(0.0, 0.0, 0.7),
+            glossy(0.0, 0.0),
+            glossy(0.3, -0.4),
+        ] {
+            for u in [0.1, 0.6] {
+                assert_eq!(
+                    format!("{:?}", from_closure_blurred(&c, u, 0.0)),
+                    format!("{:?}", from_closure(&c, u))
+                );
+            }
+        }
+        // The dielectric Principled's smooth specular layer becomes a rough one over the base.
+        let BsdfInstance::Layered(l) = from_closure_blurred(&principled(0.0, 0.0, 0.7), 0.5, b)
+        else {
+            panic!("coated");
+        };
+        match l.base {
+            BaseLobe::SpecularDiffuse(s) => assert_eq!(s.top.roughness, Roughness::new(b, b)),
+            other => panic!("{other:?}"),
+        }
+    }
 
     /// Over random geometric normals, view directions above the surface and shading normals on
     /// the viewer's side: the result is a unit vector in the plane of `n` and `ng`, the mirror
