@@ -45,7 +45,7 @@ pub fn valid_specular_normal(ng: Vec3, wi: Vec3, n: Vec3) -> Vec3 {
 /// take local +X as their tangent: the caller builds the frame from [`Closure::tangent`].
 #[inline]
 pub fn from_closure(c: &Closure, u: f32) -> BsdfInstance {
-    from_closure_blurred(c, u, 0.0)
+    build(c, u, 0.0)
 }
 
 /// `alpha` raised to at least `blur`, as Cycles' `bsdf_microfacet_blur` raises each of a
@@ -68,8 +68,15 @@ fn blurred_roughness(r: f32, blur: f32) -> f32 {
 /// near-zero-alpha GGX closure does; diffuse, translucent, sheen and transparent closures
 /// stay. Cycles finds a lobe's energy compensation when it sets the closure up, before the
 /// blur, so a lobe that was smooth gets none.
-#[inline]
+// Out of line: inlined, it would weigh on every shading point without the filter.
+#[inline(never)]
 pub fn from_closure_blurred(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
+    build(c, u, blur)
+}
+
+/// [`from_closure_blurred`], inlined into [`from_closure`] with no blur to fold away.
+#[inline(always)]
+fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
     match &c.kind {
         ClosureKind::Principled(p) if !p.cycles => choose(
             &SurfaceParams {

@@ -139,7 +139,9 @@ impl ShadingPoint {
             };
         let blur = ctx.blur;
         let (closure, inv_p, u) = scene.choose_closure(ctx, its, d, depth, u)?;
-        let bsdf = if caustics_off == 0 {
+        let bsdf = if caustics_off == 0 && blur == 0.0 {
+            bsdf::from_closure(closure, u)
+        } else if caustics_off == 0 {
             bsdf::closure::from_closure_blurred(closure, u, blur)
         } else {
             // Cycles leaves the closures of the caustics switched off out.

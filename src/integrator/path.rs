@@ -56,6 +56,25 @@ impl SplitsLight for PathMats {
         &self,
         scene: &RenderScene,
         ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        sink: &mut S,
+    ) -> Vec3 {
+        if self.paths.filter_glossy.is_on() {
+            self.path::<S, true>(scene, ctx, o, d, sink)
+        } else {
+            self.path::<S, false>(scene, ctx, o, d, sink)
+        }
+    }
+}
+
+impl PathMats {
+    /// The path loop; `BLUR`: Filter Glossy is on (off, the loop is the one without it).
+    #[inline(always)]
+    fn path<S: Sink, const BLUR: bool>(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
         mut o: Vec3,
         mut d: Vec3,
         sink: &mut S,
@@ -90,7 +109,7 @@ impl SplitsLight for PathMats {
             if depth >= end || !roulette(ctx, depth, &mut throughput) {
                 return l;
             }
-            if self.paths.filter_glossy.is_on() {
+            if BLUR {
                 ctx.blur = self.paths.filter_glossy.roughness(min_ray_pdf);
             }
             let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
@@ -113,7 +132,7 @@ impl SplitsLight for PathMats {
             if S::ACTIVE && depth == 1 {
                 weights = sp.class_weights_sampled(&rec);
             }
-            if self.paths.filter_glossy.is_on() && rec.measure != Measure::Discrete {
+            if BLUR && rec.measure != Measure::Discrete {
                 min_ray_pdf = min_ray_pdf.min(rec.pdf);
             }
             throughput *= w;
@@ -131,6 +150,25 @@ impl SplitsLight for PathMats {
 impl SplitsLight for PathMis {
     #[inline(always)]
     fn run<S: Sink>(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        sink: &mut S,
+    ) -> Vec3 {
+        if self.paths.filter_glossy.is_on() {
+            self.path::<S, true>(scene, ctx, o, d, sink)
+        } else {
+            self.path::<S, false>(scene, ctx, o, d, sink)
+        }
+    }
+}
+
+impl PathMis {
+    /// The path loop; `BLUR`: Filter Glossy is on (off, the loop is the one without it).
+    #[inline(always)]
+    fn path<S: Sink, const BLUR: bool>(
         &self,
         scene: &RenderScene,
         ctx: &mut Ctx,
@@ -175,7 +213,7 @@ impl SplitsLight for PathMis {
             if depth >= end || !roulette(ctx, depth, &mut throughput) {
                 return l;
             }
-            if self.paths.filter_glossy.is_on() {
+            if BLUR {
                 ctx.blur = self.paths.filter_glossy.roughness(min_ray_pdf);
             }
             let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
@@ -215,7 +253,7 @@ impl SplitsLight for PathMis {
             } else {
                 rec.pdf
             };
-            if self.paths.filter_glossy.is_on() && rec.measure != Measure::Discrete {
+            if BLUR && rec.measure != Measure::Discrete {
                 min_ray_pdf = min_ray_pdf.min(rec.pdf);
             }
             throughput *= w;
