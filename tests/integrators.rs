@@ -493,6 +493,12 @@ fn filter_glossy_blurs_a_caustic_after_a_diffuse_bounce() {
         "blurred {blurred:?} vs sharp {sharp:?}"
     );
     // The light off to the side, where it does not hide the mirror from the floor in view.
+    // The same image for any thread count.
+    let mut o = filter_glossy(opts("path_mis", 16, 4, 6, 5), 1.0);
+    o.threads = 1;
+    let one = render_with(small.clone(), &o, LightChoice::Power);
+    o.threads = 2;
+    assert_eq!(one, render_with(small.clone(), &o, LightChoice::Power));
     let large = caustic_scene(1.5, 0.3, 1.0);
     for b in [0.0, 1.0] {
         let mats = caustic_means(&large, "path_mats", b, 256, 10);

@@ -869,3 +869,26 @@ impl State {
         Some((opts, window))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blur_glossy_is_a_number_of_at_least_zero() {
+        let base = Settings::default();
+        assert_eq!(base.blur_glossy, 0.0, "off unless sent");
+        let patch = |v: Value| {
+            let mut m = Map::new();
+            m.insert("blur_glossy".into(), v);
+            base.patched(&m)
+        };
+        let (s, unknown) = patch(serde_json::json!(1.5)).unwrap();
+        assert!(unknown.is_empty());
+        assert_eq!(s.blur_glossy, 1.5);
+        for bad in [serde_json::json!(-1.0), serde_json::json!("soft")] {
+            let e = patch(bad.clone()).unwrap_err();
+            assert!(e.contains("blur_glossy"), "{bad}: {e}");
+        }
+    }
+}
