@@ -66,8 +66,9 @@ fn blurred_roughness(r: f32, blur: f32) -> f32 {
 /// Refraction; Principled's metal, specular, transmission and coat) has its GGX alphas raised
 /// to at least `blur` (0: none). A smooth lobe so raised becomes the rough one, as Cycles'
 /// near-zero-alpha GGX closure does; diffuse, translucent, sheen and transparent closures
-/// stay. Cycles finds a lobe's energy compensation when it sets the closure up, before the
-/// blur, so a lobe that was smooth gets none.
+/// stay. Cycles finds a lobe's energy compensation (and a layer's albedo) when it sets the
+/// closure up, before the blur: they keep the lobe's own roughness, and a lobe that was smooth
+/// gets no compensation.
 // Out of line: inlined, it would weigh on every shading point without the filter.
 #[inline(never)]
 pub fn from_closure_blurred(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
@@ -105,9 +106,9 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
             if bx.max(by) < DELTA_ALPHA {
                 BsdfInstance::Mirror(Mirror::new(*color))
             } else {
-                let l = RoughConductor::glossy(*color, bx, by);
+                let l = RoughConductor::glossy(*color, ax, ay);
                 let ms = *multiscatter && ax.max(ay) >= DELTA_ALPHA;
-                BsdfInstance::RoughConductor(if ms { l.multiscatter() } else { l })
+                BsdfInstance::RoughConductor(if ms { l.multiscatter() } else { l }.blurred(blur))
             }
         }
         ClosureKind::Glass {
@@ -123,9 +124,9 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
                 let _ = color;
                 BsdfInstance::Dielectric(Dielectric::new(*ior, Vec3::ONE))
             } else {
-                let l = RoughDielectric::glass(Vec3::ONE, *ior, b);
+                let l = RoughDielectric::glass(Vec3::ONE, *ior, alpha);
                 let ms = *multiscatter && alpha >= DELTA_ALPHA;
-                BsdfInstance::RoughDielectric(if ms { l.multiscatter() } else { l })
+                BsdfInstance::RoughDielectric(if ms { l.multiscatter() } else { l }.blurred(blur))
             }
         }
         ClosureKind::Refraction {
@@ -134,8 +135,10 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
             ior,
         } => {
             let _ = color;
-            let alpha = blurred(roughness * roughness, blur).max(DELTA_ALPHA);
-            BsdfInstance::RoughDielectric(RoughDielectric::refraction(Vec3::ONE, *ior, alpha))
+            let alpha = (roughness * roughness).max(DELTA_ALPHA);
+            BsdfInstance::RoughDielectric(
+                RoughDielectric::refraction(Vec3::ONE, *ior, alpha).blurred(blur),
+            )
         }
         ClosureKind::Translucent { color } => BsdfInstance::Translucent(Translucent::new(*color)),
         ClosureKind::Transparent { color } => BsdfInstance::Transparent(Transparent::new(*color)),
@@ -162,13 +165,10 @@ pub fn from_closure_without_caustics(
         ClosureKind::Glass { .. } if refl && refr => None,
         // Cycles keeps the glass's reflection.
         ClosureKind::Glass { roughness, ior, .. } if refr => {
-            let alpha = blurred(roughness * roughness, blur);
-            Some(BsdfInstance::RoughDielectric(RoughDielectric::reflection(
-                Vec3::ONE,
-                *ior,
-                alpha,
-                alpha,
-            )))
+            let alpha = roughness * roughness;
+            Some(BsdfInstance::RoughDielectric(
+                RoughDielectric::reflection(Vec3::ONE, *ior, alpha, alpha).blurred(blur),
+            ))
         }
         ClosureKind::Principled(p) if p.cycles => {
             let mut q = *p;
@@ -183,10 +183,11 @@ pub fn from_closure_without_caustics(
             if u < transmission {
                 if refr {
                     // Cycles keeps the transmission lobe's reflection (a refraction-less glass).
-                    let alpha = blurred(q.roughness.clamp(0.0, 1.0).powi(2), blur);
+                    let alpha = q.roughness.clamp(0.0, 1.0).powi(2);
                     return Some(BsdfInstance::RoughDielectric(
                         RoughDielectric::principled_specular(q.specular_tint, q.ior, alpha, alpha)
-                            .multiscatter(),
+                            .multiscatter()
+                            .blurred(blur),
                     ));
                 }
             } else {
@@ -226,9 +227,9 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
                 p.base_color,
                 p.specular_tint,
                 p.ior,
-                alpha,
+                alpha0,
             );
-            BaseLobe::RoughDielectric(if ms { l.multiscatter() } else { l })
+            BaseLobe::RoughDielectric(if ms { l.multiscatter() } else { l }.blurred(blur))
         }
     } else {
         let u2 = if transmission > 0.0 {
@@ -240,8 +241,8 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
             if ax.max(ay) < DELTA_ALPHA {
                 BaseLobe::Mirror(Mirror::new(p.base_color))
             } else {
-                let l = RoughConductor::f82(p.base_color, p.specular_tint, ax, ay);
-                BaseLobe::RoughConductor(if ms_aniso { l.multiscatter() } else { l })
+                let l = RoughConductor::f82(p.base_color, p.specular_tint, ax0, ay0);
+                BaseLobe::RoughConductor(if ms_aniso { l.multiscatter() } else { l }.blurred(blur))
             }
         } else if p.specular_level * p.specular_tint.max_element() <= 0.0 {
             BaseLobe::Diffuse(Diffuse::new(p.base_color))
@@ -257,13 +258,14 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
             // Cycles: a GGX reflection with the Fresnel of the level-adjusted IOR over the
             // diffuse base, which keeps what the specular layer's albedo leaves.
             let ior = principled_specular_ior(p.ior, p.specular_level);
-            let specular = RoughDielectric::principled_specular(p.specular_tint, ior, ax, ay);
+            let specular = RoughDielectric::principled_specular(p.specular_tint, ior, ax0, ay0);
+            let specular = if ms_aniso {
+                specular.multiscatter()
+            } else {
+                specular
+            };
             BaseLobe::SpecularDiffuse(Layered::new(
-                if ms_aniso {
-                    specular.multiscatter()
-                } else {
-                    specular
-                },
+                specular.blurred(blur),
                 Diffuse::new(p.base_color),
             ))
         }
@@ -397,6 +399,21 @@ mod tests {
         assert!(ax < b && ay > b, "{ax} {ay}");
         let (r, ms) = conductor(from_closure_blurred(&glossy(0.4, 0.5), 0.5, b));
         assert_eq!((r.alpha_x, r.alpha_y, ms), (b, ay, true));
+        // A rough lobe keeps the energy compensation of its own roughness (alpha 0.16).
+        match from_closure_blurred(&glossy(0.4, 0.0), 0.5, b) {
+            BsdfInstance::RoughConductor(l) => {
+                assert_eq!(l.roughness, Roughness::new(b, b));
+                assert_eq!(l.setup_roughness, Roughness::new(0.4 * 0.4, 0.4 * 0.4));
+                assert!(l.multiscatter);
+                let unblurred = match from_closure(&glossy(0.4, 0.0), 0.5) {
+                    BsdfInstance::RoughConductor(u) => u,
+                    other => panic!("{other:?}"),
+                };
+                let wi = Vec3::new(0.6, 0.0, 0.8);
+                assert_eq!(l.energy_factor(wi), unblurred.energy_factor(wi));
+            }
+            other => panic!("{other:?}"),
+        }
         let glass = closure(ClosureKind::Glass {
             color: Vec3::ONE,
             roughness: 0.0,
