@@ -270,10 +270,8 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
             ))
         }
     };
-    let coat = (p.coat_weight > 0.0).then(|| {
-        let r = blurred_roughness(p.coat_roughness.clamp(0.0, 1.0), blur);
-        Coat::new(p.coat_weight, r, p.coat_ior, p.coat_tint)
-    });
+    let coat = (p.coat_weight > 0.0)
+        .then(|| Coat::new(p.coat_weight, p.coat_roughness, p.coat_ior, p.coat_tint).blurred(blur));
     let sheen = (p.sheen_weight > 0.0 && p.sheen_tint.max_element() > 0.0)
         .then(|| Sheen::new(p.sheen_tint * p.sheen_weight, p.sheen_roughness));
     match (coat, sheen) {
@@ -460,7 +458,10 @@ mod tests {
         let TopLobe::Coat(coat) = l.top else {
             panic!("{:?}", l.top)
         };
-        assert!((coat.alpha - b).abs() < 1e-6, "coat alpha {}", coat.alpha);
+        assert_eq!(coat.alpha, b);
+        assert_eq!(coat.lobe().roughness, Roughness::new(b, b));
+        // Its albedo over the metal is that of the smooth coat it was set up as.
+        assert_eq!(coat.lobe().setup_roughness, Roughness::new(0.0, 0.0));
         match l.base {
             BaseLobe::RoughConductor(m) => {
                 assert_eq!(m.roughness, Roughness::new(b, b));

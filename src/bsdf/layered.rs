@@ -81,6 +81,21 @@ impl Coat {
         }
     }
 
+    /// The same coat with its alpha raised to at least `blur` (Filter Glossy; `blur <= 0`
+    /// changes nothing): a smooth coat becomes a rough one. Its albedo over the base and its
+    /// energy compensation stay those of the roughness it was set up with, as in Cycles.
+    #[inline]
+    pub fn blurred(self, blur: f32) -> Self {
+        if blur <= 0.0 {
+            return self;
+        }
+        Coat {
+            alpha: self.alpha.max(blur),
+            lobe: self.lobe.blurred(blur),
+            ..self
+        }
+    }
+
     #[inline]
     fn smooth(&self) -> bool {
         self.alpha < DELTA_ALPHA
