@@ -209,6 +209,8 @@ pub fn from_closure_without_caustics(
 /// Blender's Principled BSDF (4.x/5.x): one of transmission, metal or the dielectric base is
 /// chosen with probability equal to its mixture weight; coat and sheen are layered on top.
 /// Microfacet alphas are raised to at least `blur` ([`from_closure_blurred`]).
+// Always inlined: without the filter the blur folds away.
+#[inline(always)]
 fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
     let r = p.roughness.clamp(0.0, 1.0);
     let alpha0 = r * r;
