@@ -745,7 +745,8 @@ def test_f12_pixels_equal_cli(addon, tesela_bin, tmp_path, monkeypatch, private_
     s = scene.tesela
     cli = _cli_render(tesela_bin, keep / "scene.gltf",
                       ["--integrator", s.integrator, "--spp", str(s.samples), "--max-depth",
-                       str(s.max_depth), "--width", "40", "--height", "30", "--seed", str(s.seed)])
+                       str(s.max_depth), "--width", "40", "--height", "30", "--seed", str(s.seed),
+                       "--blur-glossy", repr(float(s.blur_glossy))])
     assert cli.shape == blender_img.shape
     assert np.isfinite(cli).all() and cli[..., :3].max() > 0
     assert np.array_equal(cli, blender_img)
