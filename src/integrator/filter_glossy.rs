@@ -8,6 +8,10 @@
 //! computes `blur_pdf = filter · min_ray_pdf`; when `blur_pdf < 1` every microfacet lobe there
 //! has its GGX alphas raised to at least `sqrt(1 - blur_pdf) / 2`
 //! (`surface_shader_prepare_closures`, `bsdf_microfacet_blur`).
+//!
+//! The density is that of the BSDF of the closure the hit chose (with the lobe mixture of a
+//! layered one); Cycles' is the mixture over all the hit's closures, which is the same for a
+//! single closure and differs for mixes of closures.
 
 /// The setting, ready for the path loop.
 #[derive(Clone, Copy, Debug, PartialEq)]
