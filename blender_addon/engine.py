@@ -93,7 +93,8 @@ def renderer_args(binary, gltf, settings, width, height, region, pass_names=(), 
         if hasattr(settings, prop):
             args += [option, str(getattr(settings, prop))]
     for option, prop in (("--clamp-direct", "sample_clamp_direct"),
-                         ("--clamp-indirect", "sample_clamp_indirect")):
+                         ("--clamp-indirect", "sample_clamp_indirect"),
+                         ("--blur-glossy", "blur_glossy")):
         if getattr(settings, prop, 0.0) > 0.0:
             args += [option, repr(float(getattr(settings, prop)))]
     for option, prop in (("--no-caustics-reflective", "caustics_reflective"),

@@ -51,6 +51,10 @@ class TeselaSceneSettings(bpy.types.PropertyGroup):
     sample_clamp_indirect: FloatProperty(
         name="Indirect Light", default=10.0, min=0.0,
         description="If non-zero, the maximum value for an indirect light sample")
+    blur_glossy: FloatProperty(
+        name="Filter Glossy", default=1.0, min=0.0, max=10.0,
+        description="Adaptively blur glossy shaders after blurry bounces, to reduce noise at "
+                    "the cost of accuracy")
     caustics_reflective: BoolProperty(
         name="Reflective Caustics", default=True,
         description="Use reflective caustics, resulting in a brighter image (more noise but "

@@ -82,6 +82,8 @@ class TESELA_PT_render(bpy.types.Panel):
         col = layout.column(heading="Clamping")
         col.prop(s, "sample_clamp_direct")
         col.prop(s, "sample_clamp_indirect")
+        col = layout.column()
+        col.prop(s, "blur_glossy")
         col = layout.column(heading="Caustics")
         col.prop(s, "caustics_reflective", text="Reflective")
         col.prop(s, "caustics_refractive", text="Refractive")

@@ -200,6 +200,10 @@ struct RenderArgs {
     /// bounce meet no refraction. Path integrators.
     #[arg(long)]
     no_caustics_refractive: bool,
+    /// Filter Glossy (Cycles' blur_glossy; 0 = off): after bounces sampled with a density
+    /// below B per steradian, glossy lobes are blurred. Path integrators.
+    #[arg(long, default_value_t = 0.0, value_name = "B")]
+    blur_glossy: f32,
     /// Pixel filter (Cycles' pixel_filter_type): box, gaussian or blackman-harris.
     #[arg(long, default_value = "box", value_parser = ["box", "gaussian", "blackman-harris"])]
     filter: String,
@@ -578,6 +582,7 @@ fn options(args: &RenderArgs, scene: &Scene) -> RenderOptions {
             clamp_indirect: args.clamp_indirect,
             caustics_reflective: !args.no_caustics_reflective,
             caustics_refractive: !args.no_caustics_refractive,
+            filter_glossy: tesela::integrator::filter_glossy::FilterGlossy::new(args.blur_glossy),
         },
         filter: tesela::film::PixelFilter::new(
             match args.filter.as_str() {
@@ -642,6 +647,12 @@ fn check_film_args(args: &RenderArgs) -> Result<(), String> {
                 "{name} {v}: the clamp must be a number >= 0 (0 = off)"
             ));
         }
+    }
+    if !(args.blur_glossy.is_finite() && args.blur_glossy >= 0.0) {
+        return Err(format!(
+            "--blur-glossy {}: Filter Glossy must be a number >= 0 (0 = off)",
+            args.blur_glossy
+        ));
     }
     if !(args.filter_width.is_finite() && (0.01..=10.0).contains(&args.filter_width)) {
         return Err(format!(

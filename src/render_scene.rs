@@ -136,6 +136,9 @@ pub struct Ctx {
     /// Caustics the path integrator switched off ([`crate::integrator::light_paths::caustics`]
     /// bits), for the shading of rays that left a diffuse bounce.
     pub no_caustics: u8,
+    /// The least GGX alpha of the microfacet lobes at the next hit the path integrator
+    /// shades (Cycles' Filter Glossy, [`crate::integrator::filter_glossy`]); 0 = none.
+    pub blur: f32,
 }
 
 impl Ctx {
@@ -152,6 +155,7 @@ impl Ctx {
             camera_end: None,
             trav_top: Traversal::default(),
             no_caustics: 0,
+            blur: 0.0,
         }
     }
 

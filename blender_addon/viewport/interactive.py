@@ -48,6 +48,7 @@ def session_settings(scene, pixel_size):
             "clamp_indirect": float(s.sample_clamp_indirect),
             "caustics_reflective": bool(s.caustics_reflective),
             "caustics_refractive": bool(s.caustics_refractive),
+            "blur_glossy": float(s.blur_glossy),
             "filter": s.pixel_filter_type.lower().replace("_", "-"),
             "filter_width": float(s.filter_width),
             "film_transparent": bool(scene.render.film_transparent)}

@@ -45,12 +45,45 @@ pub fn valid_specular_normal(ng: Vec3, wi: Vec3, n: Vec3) -> Vec3 {
 /// take local +X as their tangent: the caller builds the frame from [`Closure::tangent`].
 #[inline]
 pub fn from_closure(c: &Closure, u: f32) -> BsdfInstance {
+    build(c, u, 0.0)
+}
+
+/// `alpha` raised to at least `blur`, as Cycles' `bsdf_microfacet_blur` raises each of a
+/// microfacet closure's GGX alphas (`alpha = max(blur, alpha)`, in alpha = roughness², not
+/// in Blender's roughness); `blur <= 0` leaves it untouched.
+#[inline]
+fn blurred(alpha: f32, blur: f32) -> f32 {
+    if blur > 0.0 { alpha.max(blur) } else { alpha }
+}
+
+/// Blender's roughness `r` (alpha = r²) raised so that its alpha is at least `blur`.
+#[inline]
+fn blurred_roughness(r: f32, blur: f32) -> f32 {
+    if blur > 0.0 { r.max(blur.sqrt()) } else { r }
+}
+
+/// [`from_closure`] with Cycles' Filter Glossy: every microfacet lobe (Glossy, Glass,
+/// Refraction; Principled's metal, specular, transmission and coat) has its GGX alphas raised
+/// to at least `blur` (0: none). A smooth lobe so raised becomes the rough one, as Cycles'
+/// near-zero-alpha GGX closure does; diffuse, translucent, sheen and transparent closures
+/// stay. Cycles finds a lobe's energy compensation (and a layer's albedo) when it sets the
+/// closure up, before the blur: they keep the lobe's own roughness, and a lobe that was smooth
+/// gets no compensation.
+// Out of line: inlined, it would weigh on every shading point without the filter.
+#[inline(never)]
+pub fn from_closure_blurred(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
+    build(c, u, blur)
+}
+
+/// [`from_closure_blurred`], inlined into [`from_closure`] with no blur to fold away.
+#[inline(always)]
+fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
     match &c.kind {
         ClosureKind::Principled(p) if !p.cycles => choose(
             &SurfaceParams {
                 base_color: p.base_color,
                 metallic: p.metallic,
-                roughness: p.roughness,
+                roughness: blurred_roughness(p.roughness, blur),
                 transmission: p.transmission,
                 ior: p.ior,
                 specular: 2.0 * p.specular_level,
@@ -58,7 +91,7 @@ pub fn from_closure(c: &Closure, u: f32) -> BsdfInstance {
             },
             u,
         ),
-        ClosureKind::Principled(p) => principled(p, u),
+        ClosureKind::Principled(p) => principled(p, u, blur),
         ClosureKind::Diffuse { color } => BsdfInstance::Diffuse(Diffuse::new(*color)),
         ClosureKind::Glossy {
             color,
@@ -68,12 +101,14 @@ pub fn from_closure(c: &Closure, u: f32) -> BsdfInstance {
             ..
         } => {
             let (ax, ay) = anisotropy::glossy(*roughness, *a);
+            let (bx, by) = (blurred(ax, blur), blurred(ay, blur));
             // Blender's Glossy BSDF has no Fresnel; its colour is in the closure's weight.
-            if ax.max(ay) < DELTA_ALPHA {
+            if bx.max(by) < DELTA_ALPHA {
                 BsdfInstance::Mirror(Mirror::new(*color))
             } else {
                 let l = RoughConductor::glossy(*color, ax, ay);
-                BsdfInstance::RoughConductor(if *multiscatter { l.multiscatter() } else { l })
+                let ms = *multiscatter && ax.max(ay) >= DELTA_ALPHA;
+                BsdfInstance::RoughConductor(if ms { l.multiscatter() } else { l }.blurred(blur))
             }
         }
         ClosureKind::Glass {
@@ -83,13 +118,15 @@ pub fn from_closure(c: &Closure, u: f32) -> BsdfInstance {
             multiscatter,
         } => {
             let alpha = roughness * roughness;
-            if alpha < DELTA_ALPHA {
+            let b = blurred(alpha, blur);
+            if b < DELTA_ALPHA {
                 // The colour tints every path through the glass once (the closure weight).
                 let _ = color;
                 BsdfInstance::Dielectric(Dielectric::new(*ior, Vec3::ONE))
             } else {
                 let l = RoughDielectric::glass(Vec3::ONE, *ior, alpha);
-                BsdfInstance::RoughDielectric(if *multiscatter { l.multiscatter() } else { l })
+                let ms = *multiscatter && alpha >= DELTA_ALPHA;
+                BsdfInstance::RoughDielectric(if ms { l.multiscatter() } else { l }.blurred(blur))
             }
         }
         ClosureKind::Refraction {
@@ -99,20 +136,27 @@ pub fn from_closure(c: &Closure, u: f32) -> BsdfInstance {
         } => {
             let _ = color;
             let alpha = (roughness * roughness).max(DELTA_ALPHA);
-            BsdfInstance::RoughDielectric(RoughDielectric::refraction(Vec3::ONE, *ior, alpha))
+            BsdfInstance::RoughDielectric(
+                RoughDielectric::refraction(Vec3::ONE, *ior, alpha).blurred(blur),
+            )
         }
         ClosureKind::Translucent { color } => BsdfInstance::Translucent(Translucent::new(*color)),
         ClosureKind::Transparent { color } => BsdfInstance::Transparent(Transparent::new(*color)),
     }
 }
 
-/// [`from_closure`] for a ray that left a diffuse bounce with some caustics switched off
-/// (`off`: [`crate::integrator::light_paths::caustics`] bits), as Cycles' closure setup leaves
-/// them out: without reflective caustics no Glossy, no Principled metal, specular layer or
-/// coat; without refractive ones no Refraction and no Principled transmission; a Glass without
-/// either is left out (with one of them it stays whole: an approximation). `None`: nothing of
-/// the closure is left.
-pub fn from_closure_without_caustics(c: &Closure, u: f32, off: u8) -> Option<BsdfInstance> {
+/// [`from_closure_blurred`] for a ray that left a diffuse bounce with some caustics switched
+/// off (`off`: [`crate::integrator::light_paths::caustics`] bits), as Cycles' closure setup
+/// leaves them out: without reflective caustics no Glossy, no Principled metal, specular layer
+/// or coat; without refractive ones no Refraction and no Principled transmission; a Glass
+/// without either is left out (with one of them it stays whole: an approximation). `None`:
+/// nothing of the closure is left.
+pub fn from_closure_without_caustics(
+    c: &Closure,
+    u: f32,
+    off: u8,
+    blur: f32,
+) -> Option<BsdfInstance> {
     use crate::integrator::light_paths::caustics::{NO_REFLECTIVE, NO_REFRACTIVE};
     let (refl, refr) = (off & NO_REFLECTIVE != 0, off & NO_REFRACTIVE != 0);
     match &c.kind {
@@ -122,12 +166,9 @@ pub fn from_closure_without_caustics(c: &Closure, u: f32, off: u8) -> Option<Bsd
         // Cycles keeps the glass's reflection.
         ClosureKind::Glass { roughness, ior, .. } if refr => {
             let alpha = roughness * roughness;
-            Some(BsdfInstance::RoughDielectric(RoughDielectric::reflection(
-                Vec3::ONE,
-                *ior,
-                alpha,
-                alpha,
-            )))
+            Some(BsdfInstance::RoughDielectric(
+                RoughDielectric::reflection(Vec3::ONE, *ior, alpha, alpha).blurred(blur),
+            ))
         }
         ClosureKind::Principled(p) if p.cycles => {
             let mut q = *p;
@@ -145,7 +186,8 @@ pub fn from_closure_without_caustics(c: &Closure, u: f32, off: u8) -> Option<Bsd
                     let alpha = q.roughness.clamp(0.0, 1.0).powi(2);
                     return Some(BsdfInstance::RoughDielectric(
                         RoughDielectric::principled_specular(q.specular_tint, q.ior, alpha, alpha)
-                            .multiscatter(),
+                            .multiscatter()
+                            .blurred(blur),
                     ));
                 }
             } else {
@@ -158,33 +200,38 @@ pub fn from_closure_without_caustics(c: &Closure, u: f32, off: u8) -> Option<Bsd
                     return black;
                 }
             }
-            Some(principled(&q, u))
+            Some(principled(&q, u, blur))
         }
-        _ => Some(from_closure(c, u)),
+        _ => Some(from_closure_blurred(c, u, blur)),
     }
 }
 
 /// Blender's Principled BSDF (4.x/5.x): one of transmission, metal or the dielectric base is
 /// chosen with probability equal to its mixture weight; coat and sheen are layered on top.
-fn principled(p: &Principled, u: f32) -> BsdfInstance {
+/// Microfacet alphas are raised to at least `blur` ([`from_closure_blurred`]).
+// Always inlined: without the filter the blur folds away.
+#[inline(always)]
+fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
     let r = p.roughness.clamp(0.0, 1.0);
-    let alpha = r * r;
-    let (ax, ay) = anisotropy::principled(r, p.anisotropic);
+    let alpha0 = r * r;
+    let (ax0, ay0) = anisotropy::principled(r, p.anisotropic);
+    let alpha = blurred(alpha0, blur);
+    let (ax, ay) = (blurred(ax0, blur), blurred(ay0, blur));
+    // Energy compensation as set up before the blur: none for a lobe that was smooth.
+    let (ms, ms_aniso) = (alpha0 >= DELTA_ALPHA, ax0.max(ay0) >= DELTA_ALPHA);
     let metallic = p.metallic.clamp(0.0, 1.0);
     let transmission = p.transmission.clamp(0.0, 1.0) * (1.0 - metallic);
     let base = if u < transmission {
         if alpha < DELTA_ALPHA {
             BaseLobe::Dielectric(Dielectric::new(p.ior, p.base_color))
         } else {
-            BaseLobe::RoughDielectric(
-                RoughDielectric::principled_transmission(
-                    p.base_color,
-                    p.specular_tint,
-                    p.ior,
-                    alpha,
-                )
-                .multiscatter(),
-            )
+            let l = RoughDielectric::principled_transmission(
+                p.base_color,
+                p.specular_tint,
+                p.ior,
+                alpha0,
+            );
+            BaseLobe::RoughDielectric(if ms { l.multiscatter() } else { l }.blurred(blur))
         }
     } else {
         let u2 = if transmission > 0.0 {
@@ -196,9 +243,8 @@ fn principled(p: &Principled, u: f32) -> BsdfInstance {
             if ax.max(ay) < DELTA_ALPHA {
                 BaseLobe::Mirror(Mirror::new(p.base_color))
             } else {
-                BaseLobe::RoughConductor(
-                    RoughConductor::f82(p.base_color, p.specular_tint, ax, ay).multiscatter(),
-                )
+                let l = RoughConductor::f82(p.base_color, p.specular_tint, ax0, ay0);
+                BaseLobe::RoughConductor(if ms_aniso { l.multiscatter() } else { l }.blurred(blur))
             }
         } else if p.specular_level * p.specular_tint.max_element() <= 0.0 {
             BaseLobe::Diffuse(Diffuse::new(p.base_color))
@@ -214,15 +260,20 @@ fn principled(p: &Principled, u: f32) -> BsdfInstance {
             // Cycles: a GGX reflection with the Fresnel of the level-adjusted IOR over the
             // diffuse base, which keeps what the specular layer's albedo leaves.
             let ior = principled_specular_ior(p.ior, p.specular_level);
-            let specular = RoughDielectric::principled_specular(p.specular_tint, ior, ax, ay);
+            let specular = RoughDielectric::principled_specular(p.specular_tint, ior, ax0, ay0);
+            let specular = if ms_aniso {
+                specular.multiscatter()
+            } else {
+                specular
+            };
             BaseLobe::SpecularDiffuse(Layered::new(
-                specular.multiscatter(),
+                specular.blurred(blur),
                 Diffuse::new(p.base_color),
             ))
         }
     };
     let coat = (p.coat_weight > 0.0)
-        .then(|| Coat::new(p.coat_weight, p.coat_roughness, p.coat_ior, p.coat_tint));
+        .then(|| Coat::new(p.coat_weight, p.coat_roughness, p.coat_ior, p.coat_tint).blurred(blur));
     let sheen = (p.sheen_weight > 0.0 && p.sheen_tint.max_element() > 0.0)
         .then(|| Sheen::new(p.sheen_tint * p.sheen_weight, p.sheen_roughness));
     match (coat, sheen) {
@@ -266,9 +317,183 @@ fn unlayered(b: BaseLobe) -> BsdfInstance {
 
 #[cfg(test)]
 mod tests {
-    use super::valid_specular_normal;
+    use super::{from_closure, from_closure_blurred, valid_specular_normal};
+    use crate::bsdf::{BaseLobe, BsdfInstance, DielectricMode, Roughness, TopLobe};
     use crate::sampler::Sampler;
     use crate::sampling::square_to_uniform_sphere;
+    use crate::shading::{Closure, ClosureKind, Principled};
+    use glam::Vec3;
+
+    fn closure(kind: ClosureKind) -> Closure {
+        Closure {
+            weight: Vec3::ONE,
+            normal: Vec3::ZERO,
+            tangent: Vec3::ZERO,
+            surface_normal: Vec3::ZERO,
+            kind,
+        }
+    }
+
+    fn glossy(roughness: f32, anisotropy: f32) -> Closure {
+        closure(ClosureKind::Glossy {
+            color: Vec3::ONE,
+            roughness,
+            anisotropy,
+            rotation: 0.0,
+            multiscatter: true,
+        })
+    }
+
+    fn principled(metallic: f32, roughness: f32, coat_roughness: f32) -> Closure {
+        closure(ClosureKind::Principled(Principled {
+            base_color: Vec3::splat(0.8),
+            metallic,
+            roughness,
+            ior: 1.5,
+            specular_level: 0.5,
+            specular_tint: Vec3::ONE,
+            transmission: 0.0,
+            anisotropic: 0.0,
+            anisotropic_rotation: 0.0,
+            coat_weight: 1.0,
+            coat_roughness,
+            coat_ior: 1.5,
+            coat_tint: Vec3::ONE,
+            coat_normal: Vec3::ZERO,
+            sheen_weight: 0.0,
+            sheen_roughness: 0.5,
+            sheen_tint: Vec3::ONE,
+            subsurface_weight: 0.0,
+            subsurface_radius: Vec3::ONE,
+            subsurface_scale: 0.0,
+            cycles: true,
+        }))
+    }
+
+    fn conductor(b: BsdfInstance) -> (Roughness, bool) {
+        match b {
+            BsdfInstance::RoughConductor(l) => (l.roughness, l.multiscatter),
+            other => panic!("not a rough conductor: {other:?}"),
+        }
+    }
+
+    /// Cycles' `bsdf_microfacet_blur`: each GGX alpha becomes `max(blur, alpha)`; a smooth
+    /// lobe turns into the rough one without energy compensation, a lobe already rougher than
+    /// the blur is left as it was, and non-microfacet closures are untouched.
+    #[test]
+    fn filter_glossy_raises_each_alpha_to_the_blur() {
+        let b = 0.3;
+        assert_eq!(
+            conductor(from_closure_blurred(&glossy(0.0, 0.0), 0.5, b)),
+            (Roughness::new(b, b), false),
+            "a sharp Glossy"
+        );
+        // Roughness 0.8: alpha 0.64 > 0.3.
+        let rough = glossy(0.8, 0.0);
+        assert_eq!(
+            format!("{:?}", from_closure_blurred(&rough, 0.5, b)),
+            format!("{:?}", from_closure(&rough, 0.5))
+        );
+        // Roughness 0.4, anisotropy 0.5: alphas (0.08, 0.32); only the first is raised.
+        let (ax, ay) = super::anisotropy::glossy(0.4, 0.5);
+        assert!(ax < b && ay > b, "{ax} {ay}");
+        let (r, ms) = conductor(from_closure_blurred(&glossy(0.4, 0.5), 0.5, b));
+        assert_eq!((r.alpha_x, r.alpha_y, ms), (b, ay, true));
+        // A rough lobe keeps the energy compensation of its own roughness (alpha 0.16).
+        match from_closure_blurred(&glossy(0.4, 0.0), 0.5, b) {
+            BsdfInstance::RoughConductor(l) => {
+                assert_eq!(l.roughness, Roughness::new(b, b));
+                assert_eq!(l.setup_roughness, Roughness::new(0.4 * 0.4, 0.4 * 0.4));
+                assert!(l.multiscatter);
+                let unblurred = match from_closure(&glossy(0.4, 0.0), 0.5) {
+                    BsdfInstance::RoughConductor(u) => u,
+                    other => panic!("{other:?}"),
+                };
+                let wi = Vec3::new(0.6, 0.0, 0.8);
+                assert_eq!(l.energy_factor(wi), unblurred.energy_factor(wi));
+            }
+            other => panic!("{other:?}"),
+        }
+        let glass = closure(ClosureKind::Glass {
+            color: Vec3::ONE,
+            roughness: 0.0,
+            ior: 1.5,
+            multiscatter: true,
+        });
+        match from_closure_blurred(&glass, 0.5, b) {
+            BsdfInstance::RoughDielectric(l) => {
+                assert_eq!(l.roughness, Roughness::new(b, b));
+                assert_eq!(l.mode, DielectricMode::Glass);
+                assert!(l.multiscatter_fss.is_none());
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(matches!(
+            from_closure(&glass, 0.5),
+            BsdfInstance::Dielectric(_)
+        ));
+        let refraction = closure(ClosureKind::Refraction {
+            color: Vec3::ONE,
+            roughness: 0.1,
+            ior: 1.5,
+        });
+        match from_closure_blurred(&refraction, 0.5, b) {
+            BsdfInstance::RoughDielectric(l) => assert_eq!(l.roughness, Roughness::new(b, b)),
+            other => panic!("{other:?}"),
+        }
+        let diffuse = closure(ClosureKind::Diffuse { color: Vec3::ONE });
+        assert_eq!(
+            format!("{:?}", from_closure_blurred(&diffuse, 0.5, b)),
+            format!("{:?}", from_closure(&diffuse, 0.5))
+        );
+    }
+
+    /// The Principled BSDF's metal and its coat are raised alike; the blur 0 builds exactly
+    /// what [`from_closure`] builds.
+    #[test]
+    fn filter_glossy_blurs_principled_lobes_and_zero_is_no_blur() {
+        let b = 0.25;
+        let p = principled(1.0, 0.0, 0.0);
+        let BsdfInstance::Layered(l) = from_closure_blurred(&p, 0.5, b) else {
+            panic!("a coated metal is layered");
+        };
+        let TopLobe::Coat(coat) = l.top else {
+            panic!("{:?}", l.top)
+        };
+        assert_eq!(coat.alpha, b);
+        assert_eq!(coat.lobe().roughness, Roughness::new(b, b));
+        // Its albedo over the metal is that of the smooth coat it was set up as.
+        assert_eq!(coat.lobe().setup_roughness, Roughness::new(0.0, 0.0));
+        match l.base {
+            BaseLobe::RoughConductor(m) => {
+                assert_eq!(m.roughness, Roughness::new(b, b));
+                assert!(!m.multiscatter, "the smooth metal had no compensation");
+            }
+            other => panic!("{other:?}"),
+        }
+        for c in [
+            p,
+            principled(0.0, 0.0, 0.7),
+            glossy(0.0, 0.0),
+            glossy(0.3, -0.4),
+        ] {
+            for u in [0.1, 0.6] {
+                assert_eq!(
+                    format!("{:?}", from_closure_blurred(&c, u, 0.0)),
+                    format!("{:?}", from_closure(&c, u))
+                );
+            }
+        }
+        // The dielectric Principled's smooth specular layer becomes a rough one over the base.
+        let BsdfInstance::Layered(l) = from_closure_blurred(&principled(0.0, 0.0, 0.7), 0.5, b)
+        else {
+            panic!("coated");
+        };
+        match l.base {
+            BaseLobe::SpecularDiffuse(s) => assert_eq!(s.top.roughness, Roughness::new(b, b)),
+            other => panic!("{other:?}"),
+        }
+    }
 
     /// Over random geometric normals, view directions above the surface and shading normals on
     /// the viewer's side: the result is a unit vector in the plane of `n` and `ng`, the mirror

@@ -81,6 +81,21 @@ impl Coat {
         }
     }
 
+    /// The same coat with its alpha raised to at least `blur` (Filter Glossy; `blur <= 0`
+    /// changes nothing): a smooth coat becomes a rough one. Its albedo over the base and its
+    /// energy compensation stay those of the roughness it was set up with, as in Cycles.
+    #[inline]
+    pub fn blurred(self, blur: f32) -> Self {
+        if blur <= 0.0 {
+            return self;
+        }
+        Coat {
+            alpha: self.alpha.max(blur),
+            lobe: self.lobe.blurred(blur),
+            ..self
+        }
+    }
+
     #[inline]
     fn smooth(&self) -> bool {
         self.alpha < DELTA_ALPHA
@@ -134,7 +149,9 @@ impl Layer for RoughDielectric {
             return Vec3::ZERO;
         }
         let mu = wi.z.min(1.0);
-        let alpha = (self.roughness.alpha_x * self.roughness.alpha_y).sqrt();
+        // Cycles finds the albedo when it sets the closure up, before any Filter Glossy.
+        let r = &self.setup_roughness;
+        let alpha = (r.alpha_x * r.alpha_y).sqrt();
         let f = if self.f0_tint == Vec3::ONE {
             Vec3::splat(dielectric_reflection_albedo(alpha, mu, self.ior))
         } else {
@@ -144,7 +161,7 @@ impl Layer for RoughDielectric {
         };
         let darkening = match self.multiscatter_fss {
             Some(_) => {
-                let (e, _) = ggx_e(self.roughness.alpha_x, self.roughness.alpha_y, mu);
+                let (e, _) = ggx_e(r.alpha_x, r.alpha_y, mu);
                 self.energy_factor(mu, self.ior) * e
             }
             None => Vec3::ONE,

@@ -360,6 +360,9 @@ impl ConductorFresnel {
 #[derive(Clone, Copy, Debug)]
 pub struct RoughConductor {
     pub roughness: Roughness,
+    /// The roughness the lobe was set up with, where its energy compensation is looked up:
+    /// `roughness` unless Filter Glossy raised it ([`RoughConductor::blurred`]).
+    pub setup_roughness: Roughness,
     pub fresnel: ConductorFresnel,
     pub multiscatter: bool,
 }
@@ -367,8 +370,10 @@ pub struct RoughConductor {
 impl RoughConductor {
     /// Isotropic GGX with Schlick `F0` (glTF's metal).
     pub fn new(f0: Vec3, alpha: f32) -> Self {
+        let roughness = Roughness::isotropic(alpha);
         RoughConductor {
-            roughness: Roughness::isotropic(alpha),
+            roughness,
+            setup_roughness: roughness,
             fresnel: ConductorFresnel::Schlick(f0),
             multiscatter: false,
         }
@@ -376,8 +381,10 @@ impl RoughConductor {
 
     /// Any roughness and reflectance model; alphas below [`super::DELTA_ALPHA`] are raised to it.
     pub fn with(alpha_x: f32, alpha_y: f32, fresnel: ConductorFresnel) -> Self {
+        let roughness = Roughness::new(alpha_x, alpha_y);
         RoughConductor {
-            roughness: Roughness::new(alpha_x, alpha_y),
+            roughness,
+            setup_roughness: roughness,
             fresnel,
             multiscatter: false,
         }
@@ -391,13 +398,29 @@ impl RoughConductor {
         }
     }
 
+    /// The same lobe with its alphas raised to at least `blur` (Cycles' Filter Glossy,
+    /// `bsdf_microfacet_blur`; `blur <= 0` changes nothing). The energy compensation stays
+    /// that of the roughness the lobe was set up with, as Cycles does not recompute it.
+    #[inline]
+    pub fn blurred(self, blur: f32) -> Self {
+        if blur <= 0.0 {
+            return self;
+        }
+        let r = self.roughness;
+        RoughConductor {
+            roughness: Roughness::new(r.alpha_x.max(blur), r.alpha_y.max(blur)),
+            ..self
+        }
+    }
+
     /// The energy-compensation factor for this `wi` (1 without `multiscatter`).
     #[inline]
     pub fn energy_factor(&self, wi: Vec3) -> Vec3 {
         if !self.multiscatter {
             return Vec3::ONE;
         }
-        let (e, e_avg) = tables::ggx_e(self.roughness.alpha_x, self.roughness.alpha_y, wi.z);
+        let r = &self.setup_roughness;
+        let (e, e_avg) = tables::ggx_e(r.alpha_x, r.alpha_y, wi.z);
         tables::multiscatter_factor(e, e_avg, self.fresnel.fss())
     }
 

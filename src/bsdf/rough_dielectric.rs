@@ -49,6 +49,10 @@ pub struct RoughDielectric {
     /// `η_inside / η_outside`.
     pub ior: f32,
     pub roughness: Roughness,
+    /// The roughness the lobe was set up with, where its energy compensation and its albedo
+    /// as a layer are looked up: `roughness` unless Filter Glossy raised it
+    /// ([`RoughDielectric::blurred`]).
+    pub setup_roughness: Roughness,
     pub mode: DielectricMode,
     /// Cycles' generalised-Schlick `F0` scale: `F = mix(F0 · k, 1, s)` with
     /// `s = (F_real - F0) / (1 - F0)`, `F0 = ((η-1)/(η+1))²` (Principled's Specular Tint);
@@ -83,9 +87,11 @@ impl RoughDielectric {
         } else {
             1.5
         };
+        let roughness = Roughness::new(alpha_x, alpha_y);
         RoughDielectric {
             ior,
-            roughness: Roughness::new(alpha_x, alpha_y),
+            roughness,
+            setup_roughness: roughness,
             mode,
             f0_tint: Vec3::ONE,
             reflection_tint: reflection_tint.max(Vec3::ZERO),
@@ -136,12 +142,28 @@ impl RoughDielectric {
         {
             return f;
         }
-        let a = &self.roughness;
+        let a = &self.setup_roughness;
         let (e, e_avg) = match self.mode {
             DielectricMode::Glass => tables::ggx_glass_e((a.alpha_x * a.alpha_y).sqrt(), wi_z, eta),
             _ => tables::ggx_e(a.alpha_x, a.alpha_y, wi_z),
         };
         tables::multiscatter_factor(e, e_avg, fss)
+    }
+
+    /// The same lobe with its alphas raised to at least `blur` (Cycles' Filter Glossy,
+    /// `bsdf_microfacet_blur`; `blur <= 0` changes nothing). Energy compensation and layer
+    /// albedo stay those of the roughness the lobe was set up with, as in Cycles.
+    #[inline]
+    pub fn blurred(self, blur: f32) -> Self {
+        if blur <= 0.0 {
+            return self;
+        }
+        let r = self.roughness;
+        RoughDielectric {
+            roughness: Roughness::new(r.alpha_x.max(blur), r.alpha_y.max(blur)),
+            energy_at: None,
+            ..self
+        }
     }
 
     /// Computes the energy compensation for the incident direction `wi` the queries will use

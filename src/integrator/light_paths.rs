@@ -1,7 +1,8 @@
 //! Cycles' Light Paths settings beyond the total depth: bounce limits per kind of scattering,
-//! transparent pass-throughs, and sample clamping.
+//! transparent pass-throughs, sample clamping, caustics and Filter Glossy.
 
 use super::MAX_TRANSPARENT;
+use super::filter_glossy::FilterGlossy;
 use crate::shading::globals::ray;
 use glam::Vec3;
 
@@ -25,6 +26,8 @@ pub struct LightPaths {
     /// diffuse bounce meets no glossy reflection (resp. refraction) lobes.
     pub caustics_reflective: bool,
     pub caustics_refractive: bool,
+    /// Cycles' `blur_glossy` (off by default).
+    pub filter_glossy: FilterGlossy,
 }
 
 /// Bits of [`LightPaths::no_caustics`].
@@ -34,7 +37,8 @@ pub mod caustics {
 }
 
 impl Default for LightPaths {
-    /// No per-kind limit, Cycles' 8 transparent surfaces, no clamping.
+    /// No per-kind limit, Cycles' 8 transparent surfaces, no clamping, caustics on, no
+    /// Filter Glossy.
     fn default() -> Self {
         LightPaths {
             diffuse: u32::MAX,
@@ -45,6 +49,7 @@ impl Default for LightPaths {
             clamp_indirect: 0.0,
             caustics_reflective: true,
             caustics_refractive: true,
+            filter_glossy: FilterGlossy::default(),
         }
     }
 }

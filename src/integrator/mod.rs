@@ -9,6 +9,7 @@ pub mod debug;
 pub mod direct_ems;
 pub mod direct_mats;
 pub mod direct_mis;
+pub mod filter_glossy;
 pub mod light_paths;
 pub mod light_split;
 pub mod path;
@@ -120,7 +121,8 @@ impl ShadingPoint {
     /// Evaluates the material at the hit (path vertex `depth`), chooses one closure and its
     /// BSDF (one random number for both) and sets up the frame. Opaque surfaces shade both
     /// faces (the frame is flipped towards the viewer); transmissive ones keep the normal's
-    /// outward side to tell entering from leaving. `None` when nothing scatters there.
+    /// outward side to tell entering from leaving. Microfacet lobes have their alphas raised
+    /// to at least `ctx.blur` (Filter Glossy). `None` when nothing scatters there.
     pub fn new(
         scene: &RenderScene,
         ctx: &mut Ctx,
@@ -135,12 +137,15 @@ impl ShadingPoint {
             } else {
                 0
             };
+        let blur = ctx.blur;
         let (closure, inv_p, u) = scene.choose_closure(ctx, its, d, depth, u)?;
-        let bsdf = if caustics_off == 0 {
+        let bsdf = if caustics_off == 0 && blur == 0.0 {
             bsdf::from_closure(closure, u)
+        } else if caustics_off == 0 {
+            bsdf::closure::from_closure_blurred(closure, u, blur)
         } else {
             // Cycles leaves the closures of the caustics switched off out.
-            bsdf::closure::from_closure_without_caustics(closure, u, caustics_off)?
+            bsdf::closure::from_closure_without_caustics(closure, u, caustics_off, blur)?
         };
         // The closure's normal faces the viewer (Cycles' N); zero means the shading normal.
         let mut n = if closure.normal == Vec3::ZERO {

@@ -1,6 +1,7 @@
 //! Unidirectional path tracing: `path_mats` (BSDF sampling only) and `path_mis` (emitter and
 //! BSDF sampling at every vertex, power heuristic). Russian roulette from vertex 4 on, on the
-//! throughput's **maximum** component, survival probability capped at 0.95.
+//! throughput's **maximum** component, survival probability capped at 0.95. Both apply
+//! Cycles' Filter Glossy ([`super::filter_glossy`]) when it is on.
 
 use super::light_paths::{BounceCount, LightPaths};
 use super::light_split::{ClassWeights, Sink, SplitsLight};
@@ -55,6 +56,25 @@ impl SplitsLight for PathMats {
         &self,
         scene: &RenderScene,
         ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        sink: &mut S,
+    ) -> Vec3 {
+        if self.paths.filter_glossy.is_on() {
+            self.path::<S, true>(scene, ctx, o, d, sink)
+        } else {
+            self.path::<S, false>(scene, ctx, o, d, sink)
+        }
+    }
+}
+
+impl PathMats {
+    /// The path loop; `BLUR`: Filter Glossy is on (off, the loop is the one without it).
+    #[inline(always)]
+    fn path<S: Sink, const BLUR: bool>(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
         mut o: Vec3,
         mut d: Vec3,
         sink: &mut S,
@@ -66,6 +86,9 @@ impl SplitsLight for PathMats {
         let mut transparent = 0;
         let (mut counts, mut end) = (BounceCount::default(), self.max_depth);
         ctx.no_caustics = self.paths.no_caustics();
+        // Least BSDF density of the path's non-delta bounces (Filter Glossy).
+        let mut min_ray_pdf = f32::INFINITY;
+        ctx.blur = 0.0;
         loop {
             let last = depth >= end;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
@@ -85,6 +108,9 @@ impl SplitsLight for PathMats {
             };
             if depth >= end || !roulette(ctx, depth, &mut throughput) {
                 return l;
+            }
+            if BLUR {
+                ctx.blur = self.paths.filter_glossy.roughness(min_ray_pdf);
             }
             let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
                 return l;
@@ -106,6 +132,9 @@ impl SplitsLight for PathMats {
             if S::ACTIVE && depth == 1 {
                 weights = sp.class_weights_sampled(&rec);
             }
+            if BLUR && rec.measure != Measure::Discrete {
+                min_ray_pdf = min_ray_pdf.min(rec.pdf);
+            }
             throughput *= w;
             // `sample` left the new ray's Light Path bits in the context.
             if counts.count(ctx.ray_flags, &self.paths) {
@@ -124,6 +153,25 @@ impl SplitsLight for PathMis {
         &self,
         scene: &RenderScene,
         ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        sink: &mut S,
+    ) -> Vec3 {
+        if self.paths.filter_glossy.is_on() {
+            self.path::<S, true>(scene, ctx, o, d, sink)
+        } else {
+            self.path::<S, false>(scene, ctx, o, d, sink)
+        }
+    }
+}
+
+impl PathMis {
+    /// The path loop; `BLUR`: Filter Glossy is on (off, the loop is the one without it).
+    #[inline(always)]
+    fn path<S: Sink, const BLUR: bool>(
+        &self,
+        scene: &RenderScene,
+        ctx: &mut Ctx,
         mut o: Vec3,
         mut d: Vec3,
         sink: &mut S,
@@ -138,6 +186,9 @@ impl SplitsLight for PathMis {
         let mut bsdf_pdf = f32::INFINITY;
         let (mut counts, mut end) = (BounceCount::default(), self.max_depth);
         ctx.no_caustics = self.paths.no_caustics();
+        // Least BSDF density of the path's non-delta bounces (Filter Glossy).
+        let mut min_ray_pdf = f32::INFINITY;
+        ctx.blur = 0.0;
         loop {
             let last = depth >= end;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, bsdf_pdf);
@@ -161,6 +212,9 @@ impl SplitsLight for PathMis {
             };
             if depth >= end || !roulette(ctx, depth, &mut throughput) {
                 return l;
+            }
+            if BLUR {
+                ctx.blur = self.paths.filter_glossy.roughness(min_ray_pdf);
             }
             let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
                 return l;
@@ -199,6 +253,9 @@ impl SplitsLight for PathMis {
             } else {
                 rec.pdf
             };
+            if BLUR && rec.measure != Measure::Discrete {
+                min_ray_pdf = min_ray_pdf.min(rec.pdf);
+            }
             throughput *= w;
             // `sample` left the new ray's Light Path bits in the context.
             if counts.count(ctx.ray_flags, &self.paths) {

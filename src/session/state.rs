@@ -38,6 +38,8 @@ pub struct Settings {
     pub clamp_indirect: f32,
     pub caustics_reflective: bool,
     pub caustics_refractive: bool,
+    /// Cycles' `blur_glossy` (0 = off).
+    pub blur_glossy: f32,
     pub filter: FilterType,
     pub filter_width: f32,
     pub film_transparent: Option<bool>,
@@ -62,6 +64,7 @@ impl Default for Settings {
             clamp_indirect: 0.0,
             caustics_reflective: true,
             caustics_refractive: true,
+            blur_glossy: 0.0,
             filter: FilterType::Box,
             filter_width: 1.0,
             film_transparent: None,
@@ -151,6 +154,7 @@ impl Settings {
                 "film_transparent" => s.film_transparent = Some(boolean()?),
                 "caustics_reflective" => s.caustics_reflective = boolean()?,
                 "caustics_refractive" => s.caustics_refractive = boolean()?,
+                "blur_glossy" => s.blur_glossy = clamp()?,
                 _ => unknown.push(k.clone()),
             }
         }
@@ -859,8 +863,32 @@ impl State {
                 clamp_indirect: s.clamp_indirect,
                 caustics_reflective: s.caustics_reflective,
                 caustics_refractive: s.caustics_refractive,
+                filter_glossy: crate::integrator::filter_glossy::FilterGlossy::new(s.blur_glossy),
             },
         };
         Some((opts, window))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blur_glossy_is_a_number_of_at_least_zero() {
+        let base = Settings::default();
+        assert_eq!(base.blur_glossy, 0.0, "off unless sent");
+        let patch = |v: Value| {
+            let mut m = Map::new();
+            m.insert("blur_glossy".into(), v);
+            base.patched(&m)
+        };
+        let (s, unknown) = patch(serde_json::json!(1.5)).unwrap();
+        assert!(unknown.is_empty());
+        assert_eq!(s.blur_glossy, 1.5);
+        for bad in [serde_json::json!(-1.0), serde_json::json!("soft")] {
+            let e = patch(bad.clone()).unwrap_err();
+            assert!(e.contains("blur_glossy"), "{bad}: {e}");
+        }
     }
 }

@@ -52,7 +52,7 @@ def parse_args(argv):
                    "--adaptive-min-samples", "--time-limit", "--denoise-prefilter", "--filter",
                    "--filter-width", "--diffuse-bounces", "--glossy-bounces",
                    "--transmission-bounces", "--transparent-bounces", "--clamp-direct",
-                   "--clamp-indirect", "--tile-size"):
+                   "--clamp-indirect", "--blur-glossy", "--tile-size"):
             opts[a[2:].replace("-", "_")] = argv[i + 1]
             i += 2
         else:

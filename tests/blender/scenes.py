@@ -321,14 +321,16 @@ def configure_cycles(scene, width=64, height=64, spp=64, max_bounces=8, seed=0, 
 def tesela_like_cycles(settings):
     """Tesela's render settings (``scene.tesela``) matched to :func:`configure_cycles`'
     reference: fixed samples (no noise threshold, no denoiser), a 1-pixel box filter, every
-    kind of bounce up to the total, no clamping, caustics on. Integrator, samples and depth stay
-    the caller's."""
+    kind of bounce up to the total, no clamping, caustics on, no Filter Glossy. Integrator,
+    samples and depth stay the caller's."""
     settings.use_adaptive_sampling = settings.use_denoising = False
     settings.pixel_filter_type, settings.filter_width = "BOX", 1.0
     settings.diffuse_bounces = settings.glossy_bounces = settings.transmission_bounces = 1024
     settings.sample_clamp_direct = settings.sample_clamp_indirect = 0.0
     if hasattr(settings, "caustics_reflective"):
         settings.caustics_reflective = settings.caustics_refractive = True
+    if hasattr(settings, "blur_glossy"):
+        settings.blur_glossy = 0.0
 
 
 def render_cycles(path):

@@ -313,6 +313,7 @@ def test_render_pixels_orientation_and_percentage(addon, fake, private_tmp, tmp_
     assert argv[argv.index("--spp") + 1] == "4" and argv[argv.index("--max-depth") + 1] == "4"
     assert argv[argv.index("--tile-size") + 1] == "32"  # the panel's default
     assert "--no-caustics-reflective" not in argv and "--no-caustics-refractive" not in argv
+    assert argv[argv.index("--blur-glossy") + 1] == "1.0"  # Cycles' default Filter Glossy
     assert "--region" not in argv
     assert run["bin_exists"] and run["has_camera"]
     assert os.listdir(private_tmp) == []
@@ -744,7 +745,8 @@ def test_f12_pixels_equal_cli(addon, tesela_bin, tmp_path, monkeypatch, private_
     s = scene.tesela
     cli = _cli_render(tesela_bin, keep / "scene.gltf",
                       ["--integrator", s.integrator, "--spp", str(s.samples), "--max-depth",
-                       str(s.max_depth), "--width", "40", "--height", "30", "--seed", str(s.seed)])
+                       str(s.max_depth), "--width", "40", "--height", "30", "--seed", str(s.seed),
+                       "--blur-glossy", repr(float(s.blur_glossy))])
     assert cli.shape == blender_img.shape
     assert np.isfinite(cli).all() and cli[..., :3].max() > 0
     assert np.array_equal(cli, blender_img)

@@ -34,6 +34,8 @@ CASES = [
     # Rays leaving the walls and floor meet neither the mirror's nor the glass's lobes.
     ("no_caustics", {"caustics_reflective": False, "caustics_refractive": False}, 512, 1024),
     ("no_refractive_caustics", {"caustics_refractive": False}, 512, 1024),
+    # After the walls' diffuse bounces the mirror and the glass are blurred (Filter Glossy).
+    ("blur_glossy_1", {"blur_glossy": 1.0}, 512, 1024),
 ]
 
 
