@@ -42,22 +42,27 @@ class Buffer:
         return buffers
 
     def add_view(self, raw, target=None):
-        """Append raw bytes (4-byte aligned) as a bufferView; returns its index."""
+        """Append raw bytes (4-byte aligned) as a bufferView; returns its index. `raw` is any
+        contiguous buffer (bytes, a numpy array), kept as it is until the .bin is written: it
+        must not change before then."""
         pad = (-self.length) % 4
         if pad:
             self.chunks.append(b"\0" * pad)
             self.length += pad
-        view = {"buffer": 0, "byteOffset": self.length, "byteLength": len(raw)}
+        size = memoryview(raw).nbytes
+        view = {"buffer": 0, "byteOffset": self.length, "byteLength": size}
         if target is not None:
             view["target"] = target
         self.views.append(view)
         self.chunks.append(raw)
-        self.length += len(raw)
+        self.length += size
         return len(self.views) - 1
 
     def add(self, array, component, type_, target, minmax=False):
+        """An accessor over `array` (float32 for FLOAT, uint32 for UINT; not copied if it is
+        contiguous: it must not change until the .bin is written); returns its index."""
         data = np.ascontiguousarray(array)
-        view = self.add_view(data.tobytes(), target)
+        view = self.add_view(data, target)
         ncomp = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}[type_]
         acc = {"bufferView": view, "componentType": component,
                "count": int(data.size // ncomp), "type": type_}
