@@ -1,7 +1,9 @@
 # SPDX-License-Identifier: MIT
 """Small helpers shared by the export modules (matrices, finite numbers, cancellation)."""
 
+import contextlib
 import math
+import time
 
 import numpy as np
 
@@ -14,6 +16,30 @@ Z_UP_TO_Y_UP = np.array([[1, 0, 0, 0],
 
 class ExportCancelled(Exception):
     pass
+
+
+class Phases:
+    """Wall-clock seconds of one export per phase (to_mesh, normals, write, ...), summed over
+    the meshes, in the order the phases first ran: what the render log and bench/export.py
+    print."""
+
+    def __init__(self):
+        self.seconds = {}
+
+    def add(self, name, seconds):
+        self.seconds[name] = self.seconds.get(name, 0.0) + seconds
+
+    @contextlib.contextmanager
+    def __call__(self, name):
+        t0 = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.add(name, time.perf_counter() - t0)
+
+    def summary(self):
+        """'to_mesh 0.52 s, normals 0.31 s, ...' (phases under 5 ms left out)."""
+        return ", ".join("%s %.2f s" % (k, v) for k, v in self.seconds.items() if v >= 0.005)
 
 
 def matrix(mat):

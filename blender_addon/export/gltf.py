@@ -4,13 +4,14 @@ modules (mesh, material, light, camera, world) for their parts and writes .gltf 
 
 import json
 import os
+import time
 
 import numpy as np
 
 from .. import compat
 from .buffer import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT, UINT, Buffer
 from .camera import camera_extension, camera_fields, camera_matrix
-from .common import ExportCancelled, gltf_matrix, matrix
+from .common import ExportCancelled, Phases, gltf_matrix, matrix
 from .images import ImageTable, Textures
 from .instances import collapse
 from .light import convert_light
@@ -28,6 +29,7 @@ class ExportResult:
         self.gltf_path = None
         self.bin_path = None
         self.instanced_nodes = 0  # nodes folded into EXT_mesh_gpu_instancing
+        self.phases = Phases()
 
 
 class Geometry:
@@ -106,13 +108,14 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
         """The Geometry of an evaluated mesh: its data in this export's buffer, or, with a
         mesh store, in the store's file for its content (written unless a frame before wrote
         it)."""
-        raw = read_mesh(mesh, check_cancel)
+        raw = read_mesh(mesh, check_cancel, res.phases)
         if raw is None:
             return None
         if mesh_store is None:
             return build_geometry(buf, obj, mesh, raw, n_slots, tangent_uvs, texture_without_uv,
                                   warnings.append)
-        digest = raw.digest(sorted(tangent_uvs), texture_without_uv, n_slots)
+        with res.phases("digest"):
+            digest = raw.digest(sorted(tangent_uvs), texture_without_uv, n_slots)
         stored = mesh_store.get(digest)
         if stored is None:
             own, found = Buffer(), []
@@ -129,7 +132,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
 
     def build_geometry(into, obj, mesh, raw, n_slots, tangent_uvs, texture_without_uv, warn):
         """Convert the mesh and add its accessors to the Buffer `into`."""
-        data = mesh_arrays(mesh, check_cancel, tangent_uvs, warn, obj.name, raw=raw)
+        data = mesh_arrays(mesh, check_cancel, tangent_uvs, warn, obj.name, raw=raw,
+                           phases=res.phases)
         if data is None:
             return None
         attrs = {"POSITION": into.add(data.positions, FLOAT, "VEC3", ARRAY_BUFFER, True),
@@ -173,7 +177,9 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
         has no triangles."""
         # The instances of one object (collections, Geometry Nodes) repeat its name and data:
         # they skip the material lookups.
-        okey = (obj.name, obj.data.as_pointer() if obj.data is not None else 0)
+        with res.phases("to_mesh"):  # a Subdivision Surface last in the stack runs here
+            data = obj.data
+        okey = (obj.name, data.as_pointer() if data is not None else 0)
         if okey not in object_cache:
             object_cache[okey] = shared_mesh(obj)
         return object_cache[okey]
@@ -194,7 +200,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                 raise ExportCancelled()
             geometry_cache[gkey] = None
             try:
-                mesh = obj.to_mesh()
+                with res.phases("to_mesh"):
+                    mesh = obj.to_mesh()
             except RuntimeError:
                 mesh = None
             if mesh is not None:
@@ -300,6 +307,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     if not root_nodes:
         del doc["scenes"][0]["nodes"]
 
+    t_write = time.perf_counter()
     base = os.path.splitext(os.path.basename(filepath))[0]
     bin_name = base + ".bin"
     bin_path = os.path.join(os.path.dirname(os.path.abspath(filepath)), bin_name)
@@ -318,6 +326,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     with open(filepath, "w", encoding="utf-8") as f:
         json.dump(doc, f, ensure_ascii=False, separators=(",", ":"))
     res.gltf_path = filepath
+    res.phases.add("write", time.perf_counter() - t_write)
     return res
 
 

@@ -12,7 +12,7 @@ import hashlib
 import numpy as np
 
 from .. import compat
-from .common import ExportCancelled
+from .common import ExportCancelled, Phases
 
 MESHLIKE = {"MESH", "CURVE", "SURFACE", "FONT", "META", "CURVES_LEGACY"}
 
@@ -63,7 +63,8 @@ class RawMesh:
         self.loop_start = None   # int32 (n_polys,): each face's first corner
         self.face_material = None  # int32 (n_polys,)
         self.co = None           # float32 (n_verts, 3)
-        self.normals = None      # float32 (n_loops, 3), corner normals
+        self.normal_domain = None  # "POINT", "FACE" or "CORNER": what `normals` has one of
+        self.normals = None      # float32 (n, 3): vertex, face or corner normals (compat.normals)
         self.uvs = []            # [(name, float32 (n_loops, 2))], the render map first
         self.colors = []         # [(name, float32 (n_loops or n_verts, 4), domain)]
         self.texspace = None     # (location, size)
@@ -78,133 +79,259 @@ class RawMesh:
         for name, a, *domain in self.uvs + self.colors:
             h.update(repr((name, domain, a.size)).encode("utf-8"))
             h.update(np.ascontiguousarray(a).tobytes())
-        h.update(repr((self.texspace, context)).encode("utf-8"))
+        h.update(repr((self.texspace, self.normal_domain, context)).encode("utf-8"))
         return h.hexdigest()
 
 
-def read_mesh(mesh, check_cancel=None):
-    """The RawMesh of an evaluated mesh, or None if it has no faces."""
+def read_mesh(mesh, check_cancel=None, phases=None):
+    """The RawMesh of an evaluated mesh, or None if it has no faces; phases: a Phases adding up
+    the seconds of each step."""
     def checkpoint():
         if check_cancel is not None and check_cancel():
             raise ExportCancelled()
+    phases = phases or Phases()
     n_polys = len(mesh.polygons)
     if n_polys == 0:
         return None
     raw = RawMesh()
     n_loops = len(mesh.loops)
     n_verts = len(mesh.vertices)
-    raw.loop_vert = compat.corner_verts(mesh, n_loops)
-    raw.loop_start = np.empty(n_polys, dtype=np.int32)
-    mesh.polygons.foreach_get("loop_start", raw.loop_start)
-    raw.face_material = compat.face_materials(mesh, n_polys)
-    raw.co = compat.vertex_positions(mesh, n_verts)
+    with phases("positions"):
+        raw.loop_vert = compat.corner_verts(mesh, n_loops)
+        raw.loop_start = compat.face_starts(mesh, n_polys)
+        raw.face_material = compat.face_materials(mesh, n_polys)
+        raw.co = compat.vertex_positions(mesh, n_verts)
     checkpoint()
-    raw.normals = compat.corner_normals(mesh, n_loops)
+    with phases("normals"):
+        raw.normal_domain, raw.normals = compat.normals(mesh, n_loops)
     checkpoint()
-    for layer in compat.uv_layers(mesh):
-        raw.uvs.append((layer.name, compat.corner_uv(layer, n_loops)))
+    with phases("uvs"):
+        for layer in compat.uv_layers(mesh):
+            raw.uvs.append((layer.name, compat.corner_uv(layer, n_loops)))
     checkpoint()
-    for name, domain, data in compat.color_layers(mesh):
-        n = n_loops if domain == "CORNER" else n_verts
-        col = np.empty(n * 4, dtype=np.float32)
-        try:
-            data.foreach_get("color", col)
-        except (TypeError, RuntimeError, AttributeError):
-            continue
-        raw.colors.append((name, col.reshape(-1, 4), domain))
+    with phases("colors"):
+        for name, domain, data in compat.color_layers(mesh):
+            n = n_loops if domain == "CORNER" else n_verts
+            col = np.empty(n * 4, dtype=np.float32)
+            try:
+                data.foreach_get("color", col)
+            except (TypeError, RuntimeError, AttributeError):
+                continue
+            raw.colors.append((name, col.reshape(-1, 4), domain))
     checkpoint()
     raw.texspace = compat.texture_space(mesh)
     return raw
 
 
-def mesh_arrays(mesh, check_cancel=None, tangent_uvs=None, warn=None, label="", raw=None):
+def mesh_arrays(mesh, check_cancel=None, tangent_uvs=None, warn=None, label="", raw=None,
+                phases=None):
     """MeshData for an evaluated mesh (None if it has no triangles).
 
     tangent_uvs: UV map names whose tangents the materials need ("" = the active render map);
-    warn(message): where problems go; raw: the mesh's RawMesh if already read.
+    warn(message): where problems go; raw: the mesh's RawMesh if already read; phases: a
+    Phases adding up the seconds of each step.
+
+    Every corner's values are what Blender gives for that corner; corners of one vertex whose
+    values are bitwise equal share one glTF vertex (see _weld), so each triangle corner reads
+    exactly what it would with one vertex per corner.
     """
     def checkpoint():
         if check_cancel is not None and check_cancel():
             raise ExportCancelled()
     warn = warn or (lambda message: None)
+    phases = phases or Phases()
     if raw is None:
-        raw = read_mesh(mesh, check_cancel)
+        raw = read_mesh(mesh, check_cancel, phases)
         if raw is None:
             return None
-    mesh.calc_loop_triangles()
-    checkpoint()
-    nt = len(mesh.loop_triangles)
-    if nt == 0:
-        return None
-    tri = np.empty(nt * 3, dtype=np.int32)
-    mesh.loop_triangles.foreach_get("loops", tri)
-    tri_mat = np.empty(nt, dtype=np.int32)
-    mesh.loop_triangles.foreach_get("material_index", tri_mat)
+    with phases("triangles"):
+        mesh.calc_loop_triangles()
+        checkpoint()
+        nt = len(mesh.loop_triangles)
+        if nt == 0:
+            return None
+        tri = compat.loop_triangle_corners(mesh, nt)
+        tri_face = compat.loop_triangle_faces(mesh, nt)
+        tri_mat = np.take(raw.face_material, tri_face)
     loop_vert, co, normals = raw.loop_vert, raw.co, raw.normals
-    n_loops = loop_vert.shape[0]
+    n_loops, n_verts = loop_vert.shape[0], co.shape[0]
+    with phases("normals"):
+        if raw.normal_domain == "FACE":
+            # Loop triangles cover every corner: each corner's face from its triangles'.
+            loop_face = np.empty(n_loops, dtype=np.int32)
+            loop_face[tri.reshape(-1)] = np.repeat(tri_face, 3)
+            corner_normals = _take(normals, loop_face)
+        elif raw.normal_domain == "POINT":
+            corner_normals = None  # equal for every corner of a vertex
+        else:
+            corner_normals = normals
+    checkpoint()
 
     out = MeshData()
-    # One glTF vertex per corner (face corner = Blender loop): loop triangles cover every
-    # loop of every polygon, so the loop indices are the glTF indices as they are.
-    positions = co[loop_vert]
-    nrm = normals
-    sq = np.einsum("ij,ij->i", nrm, nrm)
-    if not (np.abs(sq - 1.0) < 1e-4).all():  # rare: renormalise, repair zero/NaN normals
-        length = np.sqrt(sq.astype(np.float64))
-        bad = ~(length > 1e-12)
-        length[bad] = 1.0
-        nrm = (nrm / length[:, None]).astype(np.float32)
-        nrm[bad] = (0.0, 0.0, 1.0)
-    if not np.isfinite(positions).all():
-        positions = np.nan_to_num(positions, nan=0.0, posinf=0.0, neginf=0.0)
-    out.positions, out.normals = positions, nrm
-    out.indices = tri.view(np.uint32).reshape(-1, 3)
-    out.tri_material = tri_mat
-
     layers = raw.uvs
-    blender_uvs = {}
-    for name, uv in layers:
-        blender_uvs[name] = uv
-        flipped = uv.copy()
-        flipped[:, 1] = 1.0 - flipped[:, 1]  # glTF's UV origin is the top-left corner
-        out.uv_sets.append((name, flipped))
-    checkpoint()
+    blender_uvs = dict(layers)
+    # (name, per-corner or per-vertex float32 (n, 4), per vertex?)
+    colors = [(name, col, domain != "CORNER") for name, col, domain in raw.colors]
 
-    for name, col, domain in raw.colors:
-        if domain != "CORNER":
-            col = col[loop_vert]
-        if not np.isfinite(col).all():
-            col = np.nan_to_num(col, nan=0.0, posinf=0.0, neginf=0.0)
-        out.color_sets.append((name, np.ascontiguousarray(col)))
-    checkpoint()
+    tangents = None
+    with phases("tangents"):
+        if tangent_uvs and layers:
+            names = sorted({(u or layers[0][0]) for u in tangent_uvs})
+            known = [u for u in names if u in blender_uvs]
+            for u in names:
+                if u not in blender_uvs:
+                    warn("mesh '%s': a normal map reads UV map '%s', which the mesh does not have"
+                         % (label, u))
+            if len(known) > 1:
+                warn("mesh '%s': normal maps read several UV maps (%s); tangents are written for "
+                     "'%s' only" % (label, ", ".join(known), known[0]))
+            if known:
+                uv_name = known[0]
+                try:
+                    t, sign = compat.corner_tangents(mesh, uv_name, n_loops)
+                except RuntimeError:
+                    # Blender computes MikkTSpace on triangles and quads only.
+                    warn("mesh '%s' has n-gons: its tangents are per-face approximations, not "
+                         "MikkTSpace (triangulate it to match Cycles exactly)" % label)
+                    nrm = _unit_normals(_take(normals, loop_vert) if corner_normals is None
+                                        else corner_normals)
+                    t, sign = _face_tangents(_finite(_take(co, loop_vert)), nrm,
+                                             blender_uvs[uv_name], tri)
+                tangents = (t, sign)
+                out.tangent_uv = uv_name
+                checkpoint()
+        elif tangent_uvs:
+            warn("mesh '%s' has no UV map for its normal map" % label)
 
-    if tangent_uvs and layers:
-        names = sorted({(u or layers[0][0]) for u in tangent_uvs})
-        known = [u for u in names if u in blender_uvs]
-        for u in names:
-            if u not in blender_uvs:
-                warn("mesh '%s': a normal map reads UV map '%s', which the mesh does not have"
-                     % (label, u))
-        if len(known) > 1:
-            warn("mesh '%s': normal maps read several UV maps (%s); tangents are written for "
-                 "'%s' only" % (label, ", ".join(known), known[0]))
-        if known:
-            uv_name = known[0]
-            try:
-                t, sign = compat.corner_tangents(mesh, uv_name, n_loops)
-            except RuntimeError:
-                # Blender computes MikkTSpace on triangles and quads only.
-                warn("mesh '%s' has n-gons: its tangents are per-face approximations, not "
-                     "MikkTSpace (triangulate it to match Cycles exactly)" % label)
-                t, sign = _face_tangents(positions, nrm, blender_uvs[uv_name], tri)
-            out.tangents = _tangent_vec4(t, sign, nrm)
-            out.tangent_uv = uv_name
-            checkpoint()
-    elif tangent_uvs:
-        warn("mesh '%s' has no UV map for its normal map" % label)
+    with phases("weld"):
+        if raw.normal_domain == "FACE":
+            # Flat shading: corners of one vertex lie on faces of different normals, so each
+            # corner is a glTF vertex (the rare coplanar neighbours are not worth a search).
+            src, remap, vert = None, None, loop_vert
+        else:
+            keys = list(blender_uvs.values()) + [c for _, c, per_vertex in colors
+                                                 if not per_vertex]
+            if corner_normals is not None:
+                keys.append(corner_normals)
+            if tangents is not None:
+                keys += [tangents[0], tangents[1]]
+            src, remap = _weld(loop_vert, n_verts, keys)
+            vert = np.take(loop_vert, src)  # the Blender vertex of each glTF vertex
+
+    with phases("vertices"):
+        def per_corner(a):  # a corner array's values at the glTF vertices
+            return a if src is None else _take(a, src)
+        out.positions = _finite(_take(co, vert))
+        out.normals = _unit_normals(_take(normals, vert) if corner_normals is None
+                                    else per_corner(corner_normals))
+        out.indices = (tri if remap is None else np.take(remap, tri)).view(np.uint32)
+        out.tri_material = tri_mat
+        for name, uv in blender_uvs.items():
+            flipped = per_corner(uv)
+            flipped = flipped.copy() if flipped is uv else flipped
+            flipped[:, 1] = 1.0 - flipped[:, 1]  # glTF's UV origin is the top-left corner
+            out.uv_sets.append((name, flipped))
+        for name, col, per_vertex in colors:
+            out.color_sets.append((name, _finite(_take(col, vert) if per_vertex
+                                                 else per_corner(col))))
+        if tangents is not None:
+            out.tangents = _tangent_vec4(per_corner(tangents[0]), per_corner(tangents[1]),
+                                         out.normals)
 
     out.texspace = raw.texspace
     return out
+
+
+def _finite(a):
+    """`a` with NaN and infinities as 0 (a copy only if it has any)."""
+    if np.isfinite(a).all():
+        return a
+    return np.nan_to_num(a, nan=0.0, posinf=0.0, neginf=0.0)
+
+
+def _unit_normals(nrm):
+    """Normals as they are if all have unit length (within 1e-4 in the squared length), else
+    all renormalised, with zero or NaN ones as +Z."""
+    sq = np.einsum("ij,ij->i", nrm, nrm)
+    if (np.abs(sq - 1.0) < 1e-4).all():
+        return nrm
+    length = np.sqrt(sq.astype(np.float64))
+    bad = ~(length > 1e-12)
+    length[bad] = 1.0
+    nrm = (nrm / length[:, None]).astype(np.float32)
+    nrm[bad] = (0.0, 0.0, 1.0)
+    return nrm
+
+
+# Corners left after this many rounds of _weld, or once a round joins fewer than this share of
+# the corners it looked at, get a glTF vertex each: flat-shaded corners seldom join.
+WELD_ROUNDS = 4
+WELD_MIN_SHARE = 1.0 / 8.0
+
+
+def _weld(corner_vert, n_verts, keys):
+    """glTF vertices for the corners: corners of one Blender vertex whose `keys` rows (per-corner
+    arrays, (n_corners, k) or (n_corners,), of 4-byte items) are bitwise equal share one.
+
+    Returns (src, remap): src (m,) intp, the corner each glTF vertex takes its values from;
+    remap (n_corners,) int32, the glTF vertex of each corner. In each round every vertex with
+    corners left picks one of them; those equal to it join it. Each corner's values are its
+    own, so a triangle reads the same through remap as it would with one glTF vertex per
+    corner.
+    """
+    n = corner_vert.shape[0]
+    cols = [_key_columns(k, n) for k in keys]
+    srcs = []
+    next_id = 0
+    todo = None  # None: every corner (the first round)
+    cv = corner_vert.astype(np.intp)
+    pick = np.empty(n_verts, dtype=np.intp)
+    remap = None
+    for _ in range(WELD_ROUNDS):
+        count = n if todo is None else todo.shape[0]
+        pick.fill(-1)
+        pick[cv] = np.arange(n, dtype=np.intp) if todo is None else todo  # numpy keeps the last
+        picked = np.take(pick, cv)
+        joins = np.ones(count, dtype=bool)
+        for k in cols:
+            mine = k if todo is None else np.take(k, todo, axis=0)
+            theirs = np.take(k, picked, axis=0)
+            for c in range(k.shape[1]):
+                joins &= mine[:, c] == theirs[:, c]
+        has = pick >= 0
+        ids = np.cumsum(has, dtype=np.int32)
+        ids += next_id - 1
+        # Every corner left gets its picked corner's vertex; those that did not join get
+        # another in a later round.
+        if todo is None:
+            remap = np.take(ids, cv)
+        else:
+            remap[todo] = np.take(ids, cv)
+        srcs.append(pick[has])
+        next_id += srcs[-1].shape[0]
+        share = (int(np.count_nonzero(joins)) - srcs[-1].shape[0]) / count  # joined another
+        left = np.flatnonzero(~joins)
+        todo = left if todo is None else todo[left]
+        cv = np.take(cv, left)
+        if todo.shape[0] == 0 or share < WELD_MIN_SHARE:
+            break
+    remap[todo] = np.arange(next_id, next_id + todo.shape[0], dtype=np.int32)
+    srcs.append(todo)
+    return np.concatenate(srcs), remap
+
+
+def _key_columns(key, n):
+    """A per-corner key as (n, c) unsigned integers holding its bits, two 4-byte values to a
+    column where they pair up (fewer, wider comparisons)."""
+    k = np.ascontiguousarray(key).reshape(n, -1).view(np.uint32)
+    if k.shape[1] % 2 == 0:
+        return k.view(np.uint64)
+    return k
+
+
+def _take(a, idx):
+    """a[idx] along the first axis (np.take: several times faster than fancy indexing of rows)."""
+    return np.take(a, idx, axis=0)
 
 
 def _tangent_vec4(t, sign, nrm):
