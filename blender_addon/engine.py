@@ -115,6 +115,21 @@ OLD_RENDERER = ("the renderer %s is older than this add-on: it does not speak pi
                 "version %d (install the renderer that came with the add-on)")
 
 
+def timing_line(triangles, export_seconds, stats, result_seconds):
+    """The render log's account of where the time went: the add-on's export, the renderer's
+    scene load, BVH build, render and tile stream (from its DONE statistics; phases an older
+    renderer does not report are left out), and the add-on's copies of the tiles into
+    Blender's render result."""
+    parts = ["%s triangles" % format(int(triangles), ","), "export %.2f s" % export_seconds]
+    for key, name in (("load_seconds", "load"), ("bvh_seconds", "BVH"),
+                      ("seconds", "render"), ("stream_seconds", "tile stream")):
+        value = stats.get(key)
+        if isinstance(value, (int, float)):
+            parts.append("%s %.2f s" % (name, value))
+    parts.append("result %.2f s" % result_seconds)
+    return "Tesela: " + " | ".join(parts)
+
+
 def format_time_left(elapsed, fraction):
     """'Remaining mm:ss' from the time so far and the fraction done (Cycles' stats wording)."""
     if fraction <= 0.0 or fraction >= 1.0:
@@ -299,6 +314,8 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
         if self.should_stop():
             return
         t_export = time.monotonic() - t0
+        phases = res.phases.summary()
+        print("Tesela: export %.2f s%s" % (t_export, ": " + phases if phases else ""))
 
         binary, tried = preferences.find_renderer()
         if binary is None:
@@ -364,6 +381,8 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
         # measured: a 4K frame is refreshed every ~0.8 s, a small one every 0.25 s.
         push_cost = [rw * rh * 16 / 1e9]
 
+        result_seconds = [0.0]  # copying tiles into the mirror and the result
+
         def push(final=False):
             t = time.monotonic()
             compat.pass_rect_set(target, mirror.reshape(-1))
@@ -372,6 +391,7 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
             if not final:  # end_result() publishes the final image itself
                 self.update_result(result)
             push_cost[0] = time.monotonic() - t
+            result_seconds[0] += push_cost[0]
 
         progress_dirty = False
         last_stats = 0.0
@@ -414,6 +434,7 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
                     break
             for msg in batch:
                 if isinstance(msg, protocol.Tile):
+                    t_tile = time.monotonic()
                     if hello is None:
                         error = "tile before HELLO"
                         finished = True
@@ -430,6 +451,7 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
                         if t is not None:
                             t[1][rh - y - h:rh - y, x:x + w] = data[::-1]
                     dirty = True
+                    result_seconds[0] += time.monotonic() - t_tile
                 elif isinstance(msg, protocol.Progress):
                     tiles_done, tiles_total, spp_now = msg.tiles_done, msg.tiles_total, msg.spp
                     elapsed = msg.elapsed
@@ -522,6 +544,7 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
             return
         if code not in (0, None):
             self.report({"WARNING"}, "Tesela: renderer finished but exited with %s" % _describe_exit(code))
+        print(timing_line(res.triangles, t_export, done, result_seconds[0]))
         secs = done.get("seconds", time.monotonic() - t_start)
         self.update_stats("", "Tesela | Sample %d/%d | Tile %d/%d | %.1f s (export %.2f s)" % (
             spp_now or settings.samples, settings.samples, tiles_done, tiles_total, secs, t_export))

@@ -6,7 +6,7 @@ use std::io::{BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Duration;
 use tesela::emitter::LightChoice;
 use tesela::protocol::{self, Message};
@@ -732,6 +732,7 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
         send(&Message::Error(e));
         return ExitCode::from(EXIT_USAGE);
     }
+    let load_start = std::time::Instant::now();
     let scene = match load_scene(args) {
         Ok(s) => s,
         Err(e) => {
@@ -740,6 +741,7 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
             return ExitCode::from(EXIT_LOAD);
         }
     };
+    let load_seconds = load_start.elapsed().as_secs_f64();
     let mut opts = options(args, &scene);
     if let Err(e) = render::validate(&opts) {
         send(&Message::Error(e.to_string()));
@@ -749,7 +751,9 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
     // What the tiles carry: the passes asked for (the denoiser's guides stay internal).
     let tile_passes =
         tesela::film::PassSet::parse(args.passes.iter().map(String::as_str)).unwrap_or_default();
+    let bvh_start = std::time::Instant::now();
     let rscene = prepare(scene, light_choice(args), opts.threads);
+    let bvh_seconds = bvh_start.elapsed().as_secs_f64();
     let [_, _, rw, rh] = opts.region.unwrap_or([0, 0, opts.width, opts.height]);
     let ts = opts.tile_size.max(1);
     let mut passes = Vec::new();
@@ -780,7 +784,11 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
         });
     }
     let start = std::time::Instant::now();
+    // Nanoseconds spent packing tiles and writing them into the pipe (waiting for the reader
+    // included), summed over the worker threads.
+    let stream_nanos = AtomicU64::new(0);
     let send_tile = |t: &render::Tile, passes: &tesela::film::PassSet| {
+        let t0 = std::time::Instant::now();
         send(&Message::Tile {
             x: t.x,
             y: t.y,
@@ -788,6 +796,8 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
             h: t.h,
             data: tile_data(t, passes, &tile_passes, version),
         });
+        let nanos = u64::try_from(t0.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        stream_nanos.fetch_add(nanos, Ordering::Relaxed);
     };
     let on_tile = |t: &render::Tile, done: usize, total: usize| {
         send_tile(t, &opts.passes);
@@ -822,9 +832,15 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
                 send(&Message::Error(e));
                 return ExitCode::from(EXIT_RENDER);
             }
-            send(&Message::Done(
-                serde_json::to_string(&stats).unwrap_or_default(),
-            ));
+            let mut done = serde_json::to_value(&stats).unwrap_or_default();
+            if let Some(fields) = done.as_object_mut() {
+                // Where the time went besides the render itself (`seconds`).
+                let stream = stream_nanos.load(Ordering::Relaxed) as f64 * 1e-9;
+                fields.insert("load_seconds".into(), load_seconds.into());
+                fields.insert("bvh_seconds".into(), bvh_seconds.into());
+                fields.insert("stream_seconds".into(), stream.into());
+            }
+            send(&Message::Done(done.to_string()));
             ExitCode::SUCCESS
         }
         Err(RenderError::Cancelled) => {

@@ -410,6 +410,41 @@ fn pipe_speaks_version_2_when_asked_and_refuses_unknown_versions() {
     assert_eq!(o.status.code(), Some(2));
 }
 
+/// DONE says where the time went: scene load, BVH build, render, tile stream (what the
+/// add-on's render log prints).
+#[test]
+fn pipe_done_reports_load_bvh_render_and_stream_seconds() {
+    use tesela::protocol::{self, Message};
+    let o = tesela_pipe(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "--pipe",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--spp",
+        "1",
+        "--tile-size",
+        "4",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut r = &o.stdout[..];
+    let mut done = None;
+    while let Some(m) = protocol::read(&mut r).unwrap() {
+        if let Message::Done(json) = m {
+            done = Some(json);
+        }
+    }
+    let done: serde_json::Value = serde_json::from_str(&done.expect("a DONE frame")).unwrap();
+    for key in ["seconds", "load_seconds", "bvh_seconds", "stream_seconds"] {
+        let v = done[key].as_f64().unwrap_or(f64::NAN);
+        // Each phase took some time (four tiles were streamed) and less than the whole run.
+        assert!(v > 0.0 && v < 60.0, "{key} = {v} in {done}");
+    }
+}
+
 #[test]
 fn multilayer_exr_has_blenders_channel_names() {
     let dir = std::env::temp_dir().join(format!("tesela-film-exr-{}", std::process::id()));

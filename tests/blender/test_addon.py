@@ -886,6 +886,24 @@ def test_real_renderer_error_reaches_blender(addon, tesela_bin, tmp_path, monkey
     assert os.listdir(private_tmp) == []
 
 
+def test_render_log_says_where_the_time_went(addon, tesela_bin, monkeypatch, private_tmp, capfd):
+    """F12 with the real renderer prints the export's phases, then one line with the export,
+    the renderer's load, BVH, render and tile stream, and the copies into the result."""
+    monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
+    simple_scene(width=16, height=16)
+    capfd.readouterr()
+    assert render() == {"FINISHED"}
+    out = capfd.readouterr().out
+    assert len([ln for ln in out.splitlines() if ln.startswith("Tesela: export ")]) == 1, out
+    line = [ln for ln in out.splitlines() if ln.startswith("Tesela: 14 triangles | ")]
+    assert len(line) == 1, out
+    names = [part.rsplit(" ", 2)[0] for part in line[0].split(" | ")[1:]]
+    assert names == ["export", "load", "BVH", "render", "tile stream", "result"], line
+    seconds = [float(part.rsplit(" ", 2)[1]) for part in line[0].split(" | ")[1:]]
+    assert all(0.0 <= s < 60.0 for s in seconds), line
+    assert os.listdir(private_tmp) == []
+
+
 def test_real_renderer_killed_mid_frame(addon, tesela_bin, tmp_path, monkeypatch, private_tmp):
     """SIGKILL the real renderer mid-render: a clear message, the tiles so far kept."""
     wrapper = tmp_path / "kill-renderer"
