@@ -10,7 +10,8 @@ The scene (bpy, built with foreach_set; 1,000 x 1,000-quad patches are 2 M trian
 - `Cloth`: a draped sheet, smooth, two UV maps and a corner colour attribute;
 - `Custom`: a wavy torus with custom normals (one per vertex, tilted), a UV map.
 
-    .venv/bin/python bench/export.py [--scale 1.0] [--repeats 3] [--profile] [--keep DIR]
+    .venv/bin/python bench/export.py [--scale 1.0] [--repeats 3] [--store] [--profile]
+        [--keep DIR]
 
 `--scale` multiplies every patch's quad count (0.1 = ~1 M triangles, for a quick look). Every
 export starts from a freshly evaluated scene, as F12 does (no loop triangles or normals cached
@@ -25,6 +26,7 @@ import cProfile
 import math
 import os
 import pstats
+import shutil
 import statistics
 import sys
 import tempfile
@@ -40,6 +42,7 @@ import numpy as np  # noqa: E402
 
 import scenes  # noqa: E402
 from blender_addon import export  # noqa: E402
+from blender_addon.export import mesh_store  # noqa: E402
 
 
 def patch_mesh(name, nu, nv, surface, wrap_u=False, wrap_v=False):
@@ -207,17 +210,23 @@ def subdivide(depsgraph):
     return time.perf_counter() - t0
 
 
-def export_once(path):
+def export_once(path, store=False):
     """One export of the freshly evaluated scene into fresh files (as a render's new temporary
     folder has): the result and {phase: seconds}, with "other" for what no phase covers and
-    "total"."""
+    "total". store: through an empty mesh store, as F12 does (each mesh digested, then written
+    to a file of its own)."""
     for old in (path, path.with_suffix(".bin")):
         if old.exists():
             old.unlink()
+    shutil.rmtree(path.parent / mesh_store.SUBDIR, ignore_errors=True)
+    meshes = None
+    if store:
+        meshes = mesh_store.MeshStore(str(path.parent))
+        meshes.begin_render(1)
     depsgraph = cold_depsgraph()
     subdivision = subdivide(depsgraph)
     t0, cpu0 = time.perf_counter(), time.process_time()
-    res = export.write_gltf(depsgraph, str(path), width=64, height=64)
+    res = export.write_gltf(depsgraph, str(path), width=64, height=64, mesh_store=meshes)
     total, cpu = time.perf_counter() - t0, time.process_time() - cpu0
     phases = dict(res.phases.seconds) if hasattr(res, "phases") else {}
     phases["other"] = total - sum(phases.values())
@@ -232,6 +241,8 @@ def main():
     ap.add_argument("--scale", type=float, default=1.0)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--profile", action="store_true")
+    ap.add_argument("--store", action="store_true",
+                    help="export through a mesh store, as F12 does (digests, a file per mesh)")
     ap.add_argument("--keep", help="write the glTF here (default: a temporary folder)")
     args = ap.parse_args()
     t0 = time.perf_counter()
@@ -240,9 +251,9 @@ def main():
     out = Path(args.keep or tempfile.mkdtemp())
     out.mkdir(parents=True, exist_ok=True)
     path = out / "export.gltf"
-    res, first = export_once(path)
+    res, first = export_once(path, args.store)
     print(f"{res.triangles:,} triangles")
-    runs = [export_once(path)[1] for _ in range(args.repeats)]
+    runs = [export_once(path, args.store)[1] for _ in range(args.repeats)]
     names = list(runs[0])
     print("| phase | first export s | median s | min s |")
     print("| --- | ---: | ---: | ---: |")
@@ -250,14 +261,14 @@ def main():
         vals = [r.get(k, 0.0) for r in runs]
         print(f"| {k} | {first.get(k, 0.0):.3f} | {statistics.median(vals):.3f} | "
               f"{min(vals):.3f} |")
-    size = os.path.getsize(path) + os.path.getsize(out / "export.bin")
-    print(f"files: {size / 1e6:.0f} MB (.gltf + .bin) in {out}")
+    size = sum(f.stat().st_size for f in out.rglob("*") if f.is_file())
+    print(f"files: {size / 1e6:.0f} MB (.gltf, .bin, stored meshes) in {out}")
     for w in res.warnings:
         print("warning:", w)
     if args.profile:
         prof = cProfile.Profile()
         prof.enable()
-        export_once(path)
+        export_once(path, args.store)
         prof.disable()
         pstats.Stats(prof).sort_stats("tottime").print_stats(25)
 

@@ -123,7 +123,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                                       texture_without_uv, found.append)
             if geometry is None:
                 return None
-            stored = mesh_store.put(digest, own, geometry, found)
+            with res.phases("write"):
+                stored = mesh_store.put(digest, own, geometry, found)
         if digest not in store_files:  # the same content twice in one frame: one buffer
             warnings.extend(stored.warnings)
             store_files[digest] = buf.add_file(stored.uri, stored.byte_length, stored.views,
