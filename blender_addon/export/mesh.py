@@ -75,10 +75,10 @@ class RawMesh:
         h = hashlib.blake2b(digest_size=20)
         for a in (self.loop_vert, self.loop_start, self.face_material, self.co, self.normals):
             h.update(b"|%d|" % a.size)
-            h.update(np.ascontiguousarray(a).tobytes())
+            h.update(np.ascontiguousarray(a).reshape(-1).view(np.uint8))  # bytes, no copy
         for name, a, *domain in self.uvs + self.colors:
             h.update(repr((name, domain, a.size)).encode("utf-8"))
-            h.update(np.ascontiguousarray(a).tobytes())
+            h.update(np.ascontiguousarray(a).reshape(-1).view(np.uint8))  # bytes, no copy
         h.update(repr((self.texspace, self.normal_domain, context)).encode("utf-8"))
         return h.hexdigest()
 
