@@ -223,6 +223,13 @@ def test_fast_reads_match_the_item_by_item_api(clean):
     faces = np.empty(nt, dtype=np.int32)
     me.loop_triangles.foreach_get("polygon_index", faces)
     assert np.array_equal(compat.loop_triangle_faces(me, nt), faces)
+    n_faces = len(me.polygons)
+    starts = np.empty(n_faces, dtype=np.int32)
+    me.polygons.foreach_get("loop_start", starts)
+    assert np.array_equal(compat.face_starts(me, n_faces), starts)
+    mats = np.empty(n_faces, dtype=np.int32)
+    me.polygons.foreach_get("material_index", mats)
+    assert mats.max() == 1 and np.array_equal(compat.face_materials(me, n_faces), mats)
     # In-place reads check what they read: vertex items point at the positions, so reading
     # their normals there must be refused, not return positions.
     nv = len(me.vertices)
