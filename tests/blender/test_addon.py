@@ -849,23 +849,17 @@ def _big_grid(scene, n=708):
     return ob
 
 
-def test_export_million_triangles_quickly(addon, tmp_path):
-    """The writer reads meshes with foreach_get into numpy: ~1M triangles in about a second."""
+def test_export_million_triangles(addon, tmp_path):
+    """A ~1M-triangle grid exports whole (its speed is measured by bench/export.py, not here)."""
     scene = simple_scene()
     n = 708
     ob = _big_grid(scene, n)
     mesh = ob.data
     try:
-        t0 = time.perf_counter()
         doc = _export(tmp_path / "big.gltf")
-        elapsed = time.perf_counter() - t0
         tri = sum(doc["accessors"][p["indices"]]["count"] // 3
                   for m in doc["meshes"] if m["name"] == "Grid" for p in m["primitives"])
-        print("exported %d triangles in %.2f s" % (tri, elapsed))
         assert tri == 2 * (n - 1) ** 2
-        # ~1 s on an idle core; generous for shared CI machines (a per-vertex Python loop
-        # would take minutes).
-        assert elapsed < 8.0, "export of %d triangles took %.2f s" % (tri, elapsed)
     finally:
         bpy.data.objects.remove(ob)
         bpy.data.meshes.remove(mesh)
