@@ -55,6 +55,7 @@ pub enum Op {
     Bump(nodes::bump::BumpOp),
     Displacement(nodes::displacement::DisplacementOp),
     Environment(nodes::environment::EnvironmentOp),
+    Sky(nodes::sky::SkyOp),
 }
 
 impl Op {
@@ -71,6 +72,7 @@ impl Op {
             Op::Bump(op) => op.eval(s, g),
             Op::Displacement(op) => op.eval(s, g),
             Op::Environment(op) => op.eval(s, env),
+            Op::Sky(op) => op.eval(s, g),
         }
     }
 }
