@@ -177,6 +177,36 @@ fn phase_mie(mu: f32) -> f32 {
         / (8.0 * PI * (2.0 + g2) * (1.0 + g2 - 2.0 * MIE_G * mu).powf(1.5))
 }
 
+/// Entries of the density table over `[0, ATMOSPHERE_RADIUS - EARTH_RADIUS]`: linear
+/// interpolation over 15 m steps is within 2e-5 of the exact profiles (Mie's 1.2 km scale
+/// height is the sharpest).
+const DENSITY_TABLE: usize = 4097;
+const TOP: f32 = ATMOSPHERE_RADIUS - EARTH_RADIUS;
+
+/// [`density`] tabulated.
+struct Densities(Vec<Vec3>);
+
+impl Densities {
+    fn new() -> Densities {
+        Densities(
+            (0..DENSITY_TABLE)
+                .map(|i| density(i as f32 * (TOP / (DENSITY_TABLE - 1) as f32)))
+                .collect(),
+        )
+    }
+
+    /// [`density`] at `h` metres, interpolated (exact outside the table).
+    #[inline]
+    fn at(&self, h: f32) -> Vec3 {
+        let x = h * ((DENSITY_TABLE - 1) as f32 / TOP);
+        if !(0.0..(DENSITY_TABLE - 1) as f32).contains(&x) {
+            return density(h);
+        }
+        let i = x as usize;
+        self.0[i].lerp(self.0[i + 1], x - i as f32)
+    }
+}
+
 /// Whether the ray from `pos` along `dir` hits the ground.
 fn surface_intersection(pos: Vec3, dir: Vec3) -> bool {
     if dir.z >= 0.0 {
@@ -197,20 +227,26 @@ fn atmosphere_intersection(pos: Vec3, dir: Vec3) -> Vec3 {
 
 /// Optical depth factors `(Rayleigh, Mie, ozone)` (density x metres) from `origin` along
 /// `dir` to the top of the atmosphere.
-fn ray_optical_depth(origin: Vec3, dir: Vec3) -> Vec3 {
+fn ray_optical_depth(table: &Densities, origin: Vec3, dir: Vec3) -> Vec3 {
     let end = atmosphere_intersection(origin, dir);
     let length = origin.distance(end);
     let segment = dir * length;
     let mut depth = Vec3::ZERO;
     for (&x, &w) in QUADRATURE_NODES.iter().zip(&QUADRATURE_WEIGHTS) {
         let p = origin + segment * x;
-        depth += density(p.length() - EARTH_RADIUS) * w;
+        depth += table.at(p.length() - EARTH_RADIUS) * w;
     }
     depth * length
 }
 
 /// Spectral radiance scattered once towards `origin` along the ray `origin + t dir`.
-fn single_scattering(dir: Vec3, sun: Vec3, origin: Vec3, scale: Vec3) -> [f32; NUM_WAVELENGTHS] {
+fn single_scattering(
+    table: &Densities,
+    dir: Vec3,
+    sun: Vec3,
+    origin: Vec3,
+    scale: Vec3,
+) -> [f32; NUM_WAVELENGTHS] {
     let end = atmosphere_intersection(origin, dir);
     let length = origin.distance(end);
     let seg_len = length / STEPS as f32;
@@ -222,10 +258,10 @@ fn single_scattering(dir: Vec3, sun: Vec3, origin: Vec3, scale: Vec3) -> [f32; N
     // Each segment is evaluated at its middle.
     let mut p = origin + segment * 0.5;
     for _ in 0..STEPS {
-        let d = scale * density(p.length() - EARTH_RADIUS);
+        let d = scale * table.at(p.length() - EARTH_RADIUS);
         depth += d * seg_len;
         if !surface_intersection(p, sun) {
-            let total = depth + scale * ray_optical_depth(p, sun);
+            let total = depth + scale * ray_optical_depth(table, p, sun);
             for (wl, out) in spectrum.iter_mut().enumerate() {
                 let tau = total.x * RAYLEIGH_COEFF[wl]
                     + total.y * (1.11 * MIE_COEFF)
@@ -257,6 +293,7 @@ pub fn precompute_texture(a: &Atmosphere) -> Vec<Vec3> {
     let sun = geographical_to_direction(a.sun_elevation, 0.0);
     let scale = Vec3::new(a.air, a.aerosol, a.ozone);
     let half = HEIGHT / 2;
+    let table = Densities::new();
     let mut pixels = vec![Vec3::ZERO; WIDTH * HEIGHT];
     pixels[half * WIDTH..]
         .par_chunks_mut(WIDTH)
@@ -266,7 +303,7 @@ pub fn precompute_texture(a: &Atmosphere) -> Vec<Vec3> {
             for x in 0..WIDTH / 2 {
                 let longitude = TAU / WIDTH as f32 * x as f32 - PI;
                 let dir = geographical_to_direction(latitude, longitude);
-                let xyz = spectrum_to_xyz(&single_scattering(dir, sun, origin, scale));
+                let xyz = spectrum_to_xyz(&single_scattering(&table, dir, sun, origin, scale));
                 row[x] = xyz;
                 row[WIDTH - 1 - x] = xyz;
             }
@@ -301,8 +338,9 @@ pub fn precompute_sun(a: &Atmosphere, angular_diameter: f32) -> (Vec3, Vec3) {
     if top <= 0.0 {
         return (Vec3::ZERO, Vec3::ZERO);
     }
+    let table = Densities::new();
     let at = |elevation: f32| {
-        let depth = ray_optical_depth(origin, geographical_to_direction(elevation, 0.0));
+        let depth = ray_optical_depth(&table, origin, geographical_to_direction(elevation, 0.0));
         let mut s = [0.0f32; NUM_WAVELENGTHS];
         for (wl, out) in s.iter_mut().enumerate() {
             let tau = RAYLEIGH_COEFF[wl] * depth.x * a.air + 1.11 * MIE_COEFF * depth.y * a.aerosol;
