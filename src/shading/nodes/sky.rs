@@ -113,9 +113,10 @@ impl SkyParams {
                 model,
                 sun_elevation: e,
                 altitude,
-                air: p("air_density", 1.0),
-                aerosol: finite(aerosol, 1.0),
-                ozone: p("ozone_density", 1.0),
+                // Blender's range starts at 0; a negative density would amplify the light.
+                air: p("air_density", 1.0).max(0.0),
+                aerosol: finite(aerosol, 1.0).max(0.0),
+                ozone: p("ozone_density", 1.0).max(0.0),
             },
             sun_rotation: r,
             // Clamped for numerical precision, as Cycles.
