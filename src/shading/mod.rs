@@ -128,7 +128,7 @@ mod tests {
 
         let g = graph(json!({
             "nodes": [
-                {"type": "ShaderNodeTexSky", "name": "Sky", "props": {"sky_type": "PREETHAM"},
+                {"type": "ShaderNodeTexSky", "name": "Sky", "props": {"sky_type": "HOSEK_WILKIE"},
                  "inputs": {}},
                 {"type": "ShaderNodeFancy", "name": "Fancy", "inputs": {"Color": [0.2, 0.3, 0.4, 1.0]},
                  "internal_links": {"Color": "Color"}},

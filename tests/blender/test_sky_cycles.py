@@ -1,7 +1,8 @@
 """The Sky Texture world through the add-on against Cycles: multiple and single scattering with
 the sun at 30° and 25° over the diffuse plane and spheres of test_world_cycles (the sun disc off
 frame, its light and shadows on the plane), and the sky alone seen along the horizon (the rows
-the table's elevation mapping crowds, and the ground below, which multiple scattering lights).
+the table's elevation mapping crowds, and the ground below, which multiple scattering lights);
+Preetham's analytic sky over the plane.
 
 Criteria: each channel's mean within 2%, 8x8 block means within 5% at the 95th percentile
 (imgcompare.compare). Tesela's max depth = Cycles' max bounces + 2.
@@ -42,11 +43,22 @@ def horizon_scene():
     return _sky_world(scene, "MULTIPLE_SCATTERING", 20.0, 150.0, 1.0)
 
 
+def preetham_scene():
+    """Preetham's analytic sky (no sun disc) over the plane, turbidity 3, sun 35° high."""
+    scene = _sky_world(base_scene(), "PREETHAM", 0.0, 0.0, 0.5)
+    sky = next(n for n in scene.world.node_tree.nodes if n.bl_idname == "ShaderNodeTexSky")
+    e, a = math.radians(35.0), math.radians(40.0)
+    sky.sun_direction = (math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), math.sin(e))
+    sky.turbidity = 3.0
+    return scene
+
+
 # (id, builder, Cycles max bounces, spp, film_transparent)
 CASES = [
     ("multiple_scattering", lambda: lit_scene("MULTIPLE_SCATTERING", 30.0), 3, 64, False),
     ("single_scattering", lambda: lit_scene("SINGLE_SCATTERING", 25.0), 3, 64, False),
     ("horizon", horizon_scene, 1, 16, False),
+    ("preetham", preetham_scene, 3, 64, False),
 ]
 
 

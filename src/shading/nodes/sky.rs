@@ -1,5 +1,5 @@
 //! The Sky Texture node (`ShaderNodeTexSky`) as Cycles' `svm_node_tex_sky` renders the
-//! `SINGLE_SCATTERING` and `MULTIPLE_SCATTERING` types: the precomputed sky table
+//! `PREETHAM` type ([`PreethamSky`]) and the `SINGLE_SCATTERING` and `MULTIPLE_SCATTERING` types: the precomputed sky table
 //! ([`crate::shading::sky`]) looked up by direction, plus the sun disc (its radiance
 //! interpolated between the disc's lowest and highest point, with limb darkening), XYZ to
 //! scene linear, negatives clamped.
@@ -214,8 +214,26 @@ pub fn xyz_to_rgb(xyz: Vec3) -> Vec3 {
     Vec3::new(m[0].dot(xyz), m[1].dot(xyz), m[2].dot(xyz)).max(Vec3::ZERO)
 }
 
+/// The Sky Texture's operation, one per kind of model.
 #[derive(Clone, Debug)]
-pub struct SkyOp {
+pub enum SkyOp {
+    Table(TableSky),
+    Preetham(PreethamSky),
+}
+
+impl SkyOp {
+    #[inline]
+    pub fn eval(&self, s: &mut Slots, g: &ShaderGlobals) {
+        match self {
+            SkyOp::Table(t) => t.eval(s, g),
+            SkyOp::Preetham(p) => p.eval(s),
+        }
+    }
+}
+
+/// Single and multiple scattering: the precomputed table and the sun disc.
+#[derive(Clone, Debug)]
+pub struct TableSky {
     table: Arc<SkyTable>,
     disc: Option<SunDisc>,
     sun_elevation: f32,
@@ -226,10 +244,10 @@ pub struct SkyOp {
     color: Slot,
 }
 
-impl SkyOp {
+impl TableSky {
     /// The op of `params` (precomputes the table).
-    pub fn new(params: &SkyParams, vector: Slot, color: Slot) -> SkyOp {
-        SkyOp {
+    pub fn new(params: &SkyParams, vector: Slot, color: Slot) -> TableSky {
+        TableSky {
             table: Arc::new(SkyTable::new(&params.atmosphere)),
             disc: params.disc(),
             sun_elevation: params.atmosphere.sun_elevation,
@@ -282,20 +300,128 @@ impl SkyOp {
     }
 }
 
+/// Preetham, Shirley and Smits' analytic daylight (Cycles' `PREETHAM`): Perez functions of
+/// the view's zenith angle `θ` and its angle `γ` to the sun for the CIE xyY of the sky, each
+/// normalised by its value at the zenith and scaled to the model's zenith value.
+#[derive(Clone, Debug)]
+pub struct PreethamSky {
+    /// The sun's zenith angle and Cycles' azimuth (`atan2(x, y)` of its direction).
+    theta: f32,
+    phi: f32,
+    /// Zenith values of Y, x, y over their Perez functions at the zenith.
+    radiance: [f32; 3],
+    /// Perez coefficients of Y, x, y.
+    config: [[f32; 5]; 3],
+    vector: Slot,
+    color: Slot,
+}
+
+fn perez(lam: &[f32; 5], theta: f32, gamma: f32) -> f32 {
+    let cg = gamma.cos();
+    (1.0 + lam[0] * (lam[1] / theta.cos()).exp())
+        * (1.0 + lam[2] * (lam[3] * gamma).exp() + lam[4] * cg * cg)
+}
+
+impl PreethamSky {
+    /// The model for a sun towards `sun` (Blender world) and `turbidity`.
+    pub fn new(sun: Vec3, turbidity: f32, vector: Slot, color: Slot) -> PreethamSky {
+        let sun = sun.try_normalize().unwrap_or(Vec3::Z);
+        let theta = sun.z.clamp(-1.0, 1.0).acos();
+        let phi = sun.x.atan2(sun.y);
+        let (t, t2) = (turbidity, turbidity * turbidity);
+        let (th, th2, th3) = (theta, theta * theta, theta * theta * theta);
+        let chi = (4.0 / 9.0 - t / 120.0) * (PI - 2.0 * theta);
+        let zenith_y = ((4.0453 * t - 4.9710) * chi.tan() - 0.2155 * t + 2.4192) * 0.06;
+        let zenith_x = (0.00166 * th3 - 0.00375 * th2 + 0.00209 * th) * t2
+            + (-0.02903 * th3 + 0.06377 * th2 - 0.03202 * th + 0.00394) * t
+            + (0.11693 * th3 - 0.21196 * th2 + 0.06052 * th + 0.25886);
+        let zenith_yy = (0.00275 * th3 - 0.00610 * th2 + 0.00317 * th) * t2
+            + (-0.04214 * th3 + 0.08970 * th2 - 0.04153 * th + 0.00516) * t
+            + (0.15346 * th3 - 0.26756 * th2 + 0.06670 * th + 0.26688);
+        let config = [
+            [
+                0.1787 * t - 1.4630,
+                -0.3554 * t + 0.4275,
+                -0.0227 * t + 5.3251,
+                0.1206 * t - 2.5771,
+                -0.0670 * t + 0.3703,
+            ],
+            [
+                -0.0193 * t - 0.2592,
+                -0.0665 * t + 0.0008,
+                -0.0004 * t + 0.2125,
+                -0.0641 * t - 0.8989,
+                -0.0033 * t + 0.0452,
+            ],
+            [
+                -0.0167 * t - 0.2608,
+                -0.0950 * t + 0.0092,
+                -0.0079 * t + 0.2102,
+                -0.0441 * t - 1.6537,
+                -0.0109 * t + 0.0529,
+            ],
+        ];
+        let radiance = [zenith_y, zenith_x, zenith_yy]
+            .iter()
+            .zip(&config)
+            .map(|(z, c)| z / perez(c, 0.0, theta))
+            .collect::<Vec<_>>();
+        PreethamSky {
+            theta,
+            phi,
+            radiance: [radiance[0], radiance[1], radiance[2]],
+            config,
+            vector,
+            color,
+        }
+    }
+
+    /// Scene-linear radiance towards `v` (Blender world, any length).
+    pub fn radiance(&self, v: Vec3) -> Vec3 {
+        let d = v.try_normalize().unwrap_or(Vec3::ZERO);
+        let theta = d.z.clamp(-1.0, 1.0).acos();
+        let phi = FRAC_PI_2 - d.y.atan2(d.x);
+        let cos_psi = theta.sin() * self.theta.sin() * (self.phi - phi).cos()
+            + theta.cos() * self.theta.cos();
+        let gamma = cos_psi.clamp(-1.0, 1.0).acos();
+        // Below the horizon the sky is the horizon's.
+        let theta = theta.min(FRAC_PI_2 - 0.001);
+        let yy = self.radiance[0] * perez(&self.config[0], theta, gamma);
+        let x = self.radiance[1] * perez(&self.config[1], theta, gamma);
+        let y = self.radiance[2] * perez(&self.config[2], theta, gamma);
+        // xyY to XYZ, as Cycles (zero for a zero y).
+        let big_x = if y != 0.0 { x / y * yy } else { 0.0 };
+        let big_z = if y != 0.0 && yy != 0.0 {
+            (1.0 - x - y) / y * yy
+        } else {
+            0.0
+        };
+        let c = xyz_to_rgb(Vec3::new(big_x, yy, big_z));
+        if c.is_finite() { c } else { Vec3::ZERO }
+    }
+
+    #[inline]
+    pub fn eval(&self, s: &mut Slots) {
+        let c = self.radiance(s.v(self.vector));
+        s.set_v(self.color, c);
+    }
+}
+
 /// Compiles the Sky Texture; `Ok(false)` for other kinds.
 pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
     if kind != "ShaderNodeTexSky" {
         return Ok(false);
     }
-    let Some(params) = SkyParams::of(cx.node()) else {
-        let ty = cx.prop_str("sky_type").unwrap_or("?").to_string();
+    let ty = cx.prop_str("sky_type").unwrap_or("MULTIPLE_SCATTERING");
+    let params = SkyParams::of(cx.node());
+    if params.is_none() && ty != "PREETHAM" {
         cx.warn(&format!(
             "the {ty} sky model is not rendered; it reads as black"
         ));
         let black = cx.constant(&[0.0; 3])?;
         cx.alias("Color", black, SocketType::Color);
         return Ok(true);
-    };
+    }
     if cx.prop("texture_mapping").is_some_and(|v| !v.is_null()) {
         cx.warn("the node's texture mapping is ignored");
     }
@@ -314,6 +440,31 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         out
     };
     let color = cx.output("Color", SocketType::Color)?;
-    cx.emit(Op::Sky(SkyOp::new(&params, vector, color)), true);
+    let op = match params {
+        Some(p) => SkyOp::Table(TableSky::new(&p, vector, color)),
+        None => {
+            let sun = cx
+                .prop("sun_direction")
+                .and_then(serde_json::Value::as_array)
+                .and_then(|a| {
+                    let v: Vec<f32> = a
+                        .iter()
+                        .filter_map(|x| x.as_f64())
+                        .map(|x| x as f32)
+                        .collect();
+                    (v.len() == 3).then(|| Vec3::new(v[0], v[1], v[2]))
+                })
+                .filter(|v| v.is_finite())
+                .unwrap_or(Vec3::Z);
+            let turbidity = cx.prop_f32("turbidity", 2.2);
+            SkyOp::Preetham(PreethamSky::new(sun, turbidity, vector, color))
+        }
+    };
+    cx.emit(Op::Sky(op), true);
     Ok(true)
+}
+
+/// Whether `sky_type` renders (the Hosek-Wilkie model does not).
+pub fn is_rendered(sky_type: &str) -> bool {
+    model_of(sky_type).is_some() || sky_type == "PREETHAM"
 }

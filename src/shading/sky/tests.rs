@@ -1,5 +1,5 @@
 use super::*;
-use crate::shading::nodes::sky::{SkyOp, SkyParams, sun_direction, sun_position};
+use crate::shading::nodes::sky::{SkyParams, TableSky, sun_direction, sun_position};
 use std::f32::consts::PI;
 
 fn atmosphere(model: Model, elevation_deg: f32) -> Atmosphere {
@@ -43,7 +43,7 @@ fn lum(c: Vec3) -> f32 {
 fn the_zenith_is_bluer_and_darker_than_the_horizon_and_the_sun_side_brighter() {
     for model in [Model::Multiple, Model::Single] {
         let p = params(model, 30.0, 40.0);
-        let op = SkyOp::new(&p, 0, 0);
+        let op = TableSky::new(&p, 0, 0);
         let zenith = op.radiance(Vec3::Z, false);
         // 90° away from the sun in azimuth, near the horizon.
         let horizon = op.radiance(around_sun(&p, 3.0, 90.0), false);
@@ -68,7 +68,7 @@ fn the_zenith_is_bluer_and_darker_than_the_horizon_and_the_sun_side_brighter() {
 fn the_sky_is_symmetric_in_azimuth_about_the_sun() {
     for model in [Model::Multiple, Model::Single] {
         let p = params(model, 25.0, 130.0);
-        let op = SkyOp::new(&p, 0, 0);
+        let op = TableSky::new(&p, 0, 0);
         for (e, a) in [
             (5.0, 20.0),
             (40.0, 75.0),
@@ -95,11 +95,11 @@ fn the_sky_is_symmetric_in_azimuth_about_the_sun() {
 fn a_sun_below_the_horizon_draws_no_disc_and_dims_the_sky() {
     for model in [Model::Multiple, Model::Single] {
         let low = params(model, -10.0, 0.0);
-        let op = SkyOp::new(&low, 0, 0);
+        let op = TableSky::new(&low, 0, 0);
         let at_sun = op.radiance(low.sun_dir(), false);
         let without = op.radiance(low.sun_dir(), true);
         assert_eq!(at_sun, without, "{model:?}");
-        let high = SkyOp::new(&params(model, 30.0, 0.0), 0, 0);
+        let high = TableSky::new(&params(model, 30.0, 0.0), 0, 0);
         let z_low = lum(op.radiance(Vec3::Z, false));
         let z_high = lum(high.radiance(Vec3::Z, false));
         assert!(z_low < 0.1 * z_high, "{model:?} {z_low} {z_high}");
@@ -123,7 +123,7 @@ fn the_disc_is_redder_and_dimmer_low_and_its_mean_matches_the_guided_power() {
         // ∫ L dω over the disc by quadrature against the guided sun's estimate (the disc's
         // centre radiance times 0.8, the mean of its limb darkening, times its solid angle).
         let p = params(model, 35.0, 70.0);
-        let op = SkyOp::new(&p, 0, 0);
+        let op = TableSky::new(&p, 0, 0);
         let guided = match crate::shading::nodes::sky::suns(&sky_graph(model, 35.0, 70.0)) {
             crate::shading::nodes::sky::Suns::Guided(g) => g,
             other => panic!("{other:?}"),
@@ -224,4 +224,37 @@ fn sky_precompute_time() {
         let table = SkyTable::new(&a);
         println!("{model:?}: {:?} ({:?})", t.elapsed(), table.texel(256, 200));
     }
+}
+
+#[test]
+fn preetham_is_symmetric_about_the_sun_brighter_near_it_and_finite_everywhere() {
+    use crate::shading::nodes::sky::PreethamSky;
+    let (e, a) = (35f32.to_radians(), 40f32.to_radians());
+    let sun = Vec3::new(e.cos() * a.cos(), e.cos() * a.sin(), e.sin());
+    let sky = PreethamSky::new(sun, 3.0, 0, 0);
+    let at = |elev: f32, az: f32| {
+        let (el, az) = (elev.to_radians(), a + az.to_radians());
+        sky.radiance(Vec3::new(
+            el.cos() * az.cos(),
+            el.cos() * az.sin(),
+            el.sin(),
+        ))
+    };
+    for (el, az) in [(10.0, 30.0), (50.0, 100.0), (2.0, 170.0)] {
+        let (l, r) = (at(el, az), at(el, -az));
+        assert!(
+            (l - r).abs().max_element() < 1e-4 * l.max_element(),
+            "{l} {r}"
+        );
+    }
+    assert!(lum(at(35.0, 5.0)) > 3.0 * lum(at(35.0, 180.0)));
+    assert!(
+        lum(at(2.0, 90.0)) > lum(sky.radiance(Vec3::Z)),
+        "the horizon is brighter"
+    );
+    for d in [Vec3::ZERO, -Vec3::Z, Vec3::new(1.0, 0.0, -1e-7)] {
+        assert!(sky.radiance(d).is_finite() && sky.radiance(d).min_element() >= 0.0);
+    }
+    let below = PreethamSky::new(Vec3::new(1.0, 0.0, -0.2), 10.0, 0, 0);
+    assert!(below.radiance(Vec3::Z).is_finite());
 }
