@@ -11,6 +11,11 @@
 //! `p(u, t) / (2π² sin θ)` with `sin θ` of the direction itself, exactly the Jacobian of the
 //! map, so `sample` and `pdf` agree everywhere. The map is evaluated as Cycles evaluates it:
 //! with no Light Path bits set (neither camera nor any bounce type).
+//!
+//! A Sky Texture's sun disc is far smaller than a map cell: as Cycles' sun guiding, a world
+//! with one such sun leaves it out of the map (evaluated with `ray::IMPORTANCE_BAKE`) and
+//! draws [`SUN_FRACTION`] of its samples uniformly in the sun's cone; the density of every
+//! direction is the mixture `f p_cone + (1 - f) p_map`, whichever strategy drew it.
 
 use super::{Emitter, EmitterQueryRecord, luminance};
 use crate::sampling::{
