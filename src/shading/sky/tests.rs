@@ -218,11 +218,24 @@ fn sun_position_wraps_as_cycles() {
 #[test]
 #[ignore = "timing, not a check: cargo test --profile ci sky_precompute_time -- --ignored --nocapture"]
 fn sky_precompute_time() {
+    // CPU time of the process (all threads): wall time means little on a shared machine.
+    let cpu = || {
+        let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+        // SAFETY: getrusage fills the struct it is given.
+        unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
+        let t = |v: libc::timeval| v.tv_sec as f64 + v.tv_usec as f64 * 1e-6;
+        t(u.ru_utime) + t(u.ru_stime)
+    };
     for model in [Model::Multiple, Model::Single] {
         let a = atmosphere(model, 30.0);
-        let t = std::time::Instant::now();
+        let (t, c) = (std::time::Instant::now(), cpu());
         let table = SkyTable::new(&a);
-        println!("{model:?}: {:?} ({:?})", t.elapsed(), table.texel(256, 200));
+        println!(
+            "{model:?}: wall {:?}, CPU {:.3} s ({:?})",
+            t.elapsed(),
+            cpu() - c,
+            table.texel(256, 200)
+        );
     }
 }
 
