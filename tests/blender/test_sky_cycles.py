@@ -10,7 +10,6 @@ Criteria: each channel's mean within 2%, 8x8 block means within 5% at the 95th p
 
 import math
 
-import bpy
 import pytest
 
 import imgcompare
