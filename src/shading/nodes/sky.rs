@@ -245,10 +245,10 @@ pub struct TableSky {
 }
 
 impl TableSky {
-    /// The op of `params` (precomputes the table).
+    /// The op of `params` (precomputes the table unless one for the same atmosphere is live).
     pub fn new(params: &SkyParams, vector: Slot, color: Slot) -> TableSky {
         TableSky {
-            table: Arc::new(SkyTable::new(&params.atmosphere)),
+            table: SkyTable::shared(&params.atmosphere),
             disc: params.disc(),
             sun_elevation: params.atmosphere.sun_elevation,
             sun_rotation: params.sun_rotation,

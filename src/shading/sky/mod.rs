@@ -13,6 +13,7 @@ pub mod single_scattering;
 
 use glam::Vec3;
 use std::f32::consts::FRAC_PI_2;
+use std::sync::{Arc, Mutex, Weak};
 
 /// Table width (azimuth) and height (elevation), as Cycles'.
 pub const WIDTH: usize = 512;
@@ -62,6 +63,24 @@ impl SkyTable {
         };
         debug_assert_eq!(xyz.len(), WIDTH * HEIGHT);
         SkyTable { xyz }
+    }
+
+    /// The table of `atmosphere`, shared with any other still in use for the same parameters:
+    /// rebuilding a scene's lights recompiles its world, which need not precompute again.
+    pub fn shared(atmosphere: &Atmosphere) -> Arc<SkyTable> {
+        static LIVE: Mutex<Vec<(Atmosphere, Weak<SkyTable>)>> = Mutex::new(Vec::new());
+        let mut live = LIVE.lock().unwrap_or_else(|e| e.into_inner());
+        live.retain(|(_, w)| w.strong_count() > 0);
+        if let Some(t) = live
+            .iter()
+            .find(|(a, _)| a == atmosphere)
+            .and_then(|(_, w)| w.upgrade())
+        {
+            return t;
+        }
+        let t = Arc::new(SkyTable::new(atmosphere));
+        live.push((*atmosphere, Arc::downgrade(&t)));
+        t
     }
 
     /// Texel `(x, y)`.

@@ -1,6 +1,7 @@
 use super::*;
 use crate::shading::nodes::sky::{SkyParams, TableSky, sun_direction, sun_position};
 use std::f32::consts::PI;
+use std::sync::Arc;
 
 fn atmosphere(model: Model, elevation_deg: f32) -> Atmosphere {
     Atmosphere {
@@ -200,6 +201,21 @@ fn the_table_is_deterministic_for_any_thread_count() {
     assert!(many.xyz == one.xyz);
     let s = atmosphere(Model::Single, 20.0);
     assert!(SkyTable::new(&s).xyz == SkyTable::new(&s).xyz);
+}
+
+#[test]
+fn live_tables_are_shared_and_dropped_ones_rebuilt() {
+    let a = atmosphere(Model::Single, 12.5);
+    let t = SkyTable::shared(&a);
+    assert!(Arc::ptr_eq(&t, &SkyTable::shared(&a)));
+    let other = SkyTable::shared(&Atmosphere { ozone: 2.0, ..a });
+    assert!(!Arc::ptr_eq(&t, &other));
+    let weak = Arc::downgrade(&t);
+    drop(t);
+    assert!(
+        weak.upgrade().is_none(),
+        "the cache does not keep tables alive"
+    );
 }
 
 #[test]
