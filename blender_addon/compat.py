@@ -684,6 +684,15 @@ def _translate_musgrave(node, entry, index, emit):
     return {k: list(v) for k, v in outputs.items()}
 
 
+def _translate_sky(entry):
+    """Before 5.0 single scattering was called Nishita and the aerosols dust."""
+    props = entry["props"]
+    if props.get("sky_type") == "NISHITA":
+        props["sky_type"] = "SINGLE_SCATTERING"
+    if "dust_density" in props:
+        props.setdefault("aerosol_density", props.pop("dust_density"))
+
+
 def translate_node(node, entry, index, emit):
     """Rewrite `entry` into the 5.x vocabulary (see the comment above). Returns the moved outputs."""
     t = entry["type"]
@@ -719,6 +728,9 @@ def translate_node(node, entry, index, emit):
         entry["type"] = "ShaderNodeBsdfSheen"
         entry["props"] = {"distribution": "ASHIKHMIN"}
         _rename(entry, {"Sigma": "Roughness"})
+        return None
+    if t == "ShaderNodeTexSky":
+        _translate_sky(entry)
         return None
     if t == "ShaderNodeBsdfHairPrincipled" and "model" not in entry["props"]:
         entry["props"]["model"] = "CHIANG"

@@ -534,7 +534,7 @@ fn tesela_world_graph_images_sky_and_settings_load() {
                      "props": {"image": 0, "projection": "EQUIRECTANGULAR",
                                "interpolation": "Closest", "colorspace": "Non-Color"}},
                     {"name": "Sky Texture", "type": "ShaderNodeTexSky",
-                     "props": {"sky_type": "MULTIPLE_SCATTERING"}},
+                     "props": {"sky_type": "HOSEK_WILKIE"}},
                     {"name": "Add", "type": "ShaderNodeMix",
                      "props": {"data_type": "RGBA", "blend_type": "ADD"},
                      "inputs": {"Factor_Float": 1.0, "A_Color": {"link": [0, "Color"]},
@@ -556,7 +556,10 @@ fn tesela_world_graph_images_sky_and_settings_load() {
         .iter()
         .find(|w| w.contains("world 'Sunset'") && w.contains("'Sky Texture'"))
         .unwrap_or_else(|| panic!("no sky warning in {:?}", s.warnings));
-    assert!(sky_warning.contains("colour"), "{sky_warning}");
+    assert!(
+        sky_warning.contains("colour") && sky_warning.contains("HOSEK_WILKIE"),
+        "{sky_warning}"
+    );
     // The sky reads as the world's colour, added to the image: +X is the image's left
     // texel's right edge... use the texels' centres: u = 0.25 (+Y) and 0.75 (-Y).
     let env = environment(&s);

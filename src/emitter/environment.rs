@@ -11,16 +11,26 @@
 //! `p(u, t) / (2π² sin θ)` with `sin θ` of the direction itself, exactly the Jacobian of the
 //! map, so `sample` and `pdf` agree everywhere. The map is evaluated as Cycles evaluates it:
 //! with no Light Path bits set (neither camera nor any bounce type).
+//!
+//! A Sky Texture's sun disc is far smaller than a map cell: as Cycles' sun guiding, a world
+//! with one such sun leaves it out of the map (evaluated with `ray::IMPORTANCE_BAKE`) and
+//! draws [`SUN_FRACTION`] of its samples uniformly in the sun's cone; the density of every
+//! direction is the mixture `f p_cone + (1 - f) p_map`, whichever strategy drew it.
 
 use super::{Emitter, EmitterQueryRecord, luminance};
-use crate::sampling::{square_to_uniform_sphere, square_to_uniform_sphere_pdf};
+use crate::sampling::{
+    square_to_uniform_cone, square_to_uniform_cone_pdf, square_to_uniform_sphere,
+    square_to_uniform_sphere_pdf,
+};
 use crate::scene::{Image, Scene, World, WorldSampling};
 use crate::shading::Program;
+use crate::shading::globals::ray;
 use crate::shading::globals::{ShadeEnv, from_blender, to_blender};
 use crate::shading::graph::Graph;
 use crate::shading::nodes::environment::{
     background_globals, direction_to_equirectangular, equirectangular_to_direction,
 };
+use crate::shading::nodes::sky::{self, GuidedSun, Suns};
 use glam::{Mat4, Vec2, Vec3};
 use rayon::prelude::*;
 use std::f32::consts::PI;
@@ -32,6 +42,11 @@ pub const MAX_AUTO_WIDTH: usize = 2048;
 /// Largest map edge accepted from `sample_map_resolution`.
 pub const MAX_MANUAL_WIDTH: usize = 4096;
 const MAX_SUPERSAMPLE: usize = 4;
+/// The automatic map of a sky whose sun is sampled apart (Cycles' 512 x 256).
+const SKY_WIDTH: usize = 512;
+/// The share of samples drawn from a guided sun's cone (Cycles' weights: 4 for the sun, 1
+/// for the map).
+const SUN_FRACTION: f32 = 0.8;
 /// Smallest map (cells): procedural worlds over a tiny image still get a useful map.
 const MIN_WIDTH: usize = 64;
 const MIN_HEIGHT: usize = 32;
@@ -51,6 +66,13 @@ pub fn map_resolution(world: &World, graph: &Graph, images: &[Image]) -> Option<
         }
         WorldSampling::Automatic => {
             let (mut w, mut h) = (0usize, 0usize);
+            // As Cycles: a sun sampled apart needs only a coarse map of the sky; suns the map
+            // must resolve get the finest automatic one.
+            match sky::suns(graph) {
+                Suns::None => {}
+                Suns::Guided(_) => (w, h) = (SKY_WIDTH, SKY_WIDTH / 2),
+                Suns::Unguided => (w, h) = (MAX_AUTO_WIDTH, MAX_AUTO_WIDTH / 2),
+            }
             for n in &graph.nodes {
                 if n.kind == "ShaderNodeTexEnvironment"
                     && let Some(img) = n.image.and_then(|i| images.get(i))
@@ -229,6 +251,44 @@ pub struct Environment {
     dist: Option<Box<Distribution2D>>,
     /// `∫ luminance dω` over the sphere, for light selection (0: not a light).
     integral: f32,
+    /// A sky's sun sampled apart (Cycles' sun guiding): the map leaves its disc out and
+    /// [`SUN_FRACTION`] of the samples are drawn uniformly in its cone.
+    sun: Option<SunCone>,
+}
+
+/// A guided sun's cone in the renderer's world.
+#[derive(Clone, Copy, Debug)]
+struct SunCone {
+    /// Unit direction towards the centre.
+    dir: Vec3,
+    /// Frame with `dir` as its third axis.
+    t: Vec3,
+    b: Vec3,
+    cos_max: f32,
+}
+
+impl SunCone {
+    fn new(s: &GuidedSun) -> SunCone {
+        let dir = from_blender(s.dir).normalize();
+        let (t, b) = dir.any_orthonormal_pair();
+        SunCone {
+            dir,
+            t,
+            b,
+            cos_max: s.half_angle.cos(),
+        }
+    }
+
+    #[inline]
+    fn sample(&self, u: Vec2) -> Vec3 {
+        let l = square_to_uniform_cone(u, self.cos_max);
+        (self.t * l.x + self.b * l.y + self.dir * l.z).normalize()
+    }
+
+    #[inline]
+    fn pdf(&self, d: Vec3) -> f32 {
+        square_to_uniform_cone_pdf(Vec3::new(0.0, 0.0, d.dot(self.dir)), self.cos_max)
+    }
 }
 
 /// Cycles' equirectangular `(u, v)` of a cell-space point `(u, t)` (`t = θ / π` from the top).
@@ -251,16 +311,27 @@ impl Environment {
             camera_to_world,
             dist: None,
             integral: 0.0,
+            sun: None,
         };
         let Some([w, h, ss]) = res else {
             return env;
+        };
+        let guided = match scene.world.graph.as_ref().map(sky::suns) {
+            Some(Suns::Guided(s)) => Some(s),
+            _ => None,
+        };
+        let bake = if guided.is_some() {
+            ray::IMPORTANCE_BAKE
+        } else {
+            0
         };
         // Per cell: the sampling weight, and the radiance at its centre (for the power).
         let mut cells = vec![(0.0f32, 0.0f32); w * h];
         cells.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
             for (i, out) in row.iter_mut().enumerate() {
                 let lum_at = |u: f32, t: f32| {
-                    let l = luminance(env.light_radiance(scene, cell_direction(u, t)));
+                    let d = cell_direction(u, t);
+                    let l = luminance(env.radiance(scene, d, LIGHT_DEPTH, bake));
                     if l.is_finite() && l > 0.0 { l } else { 0.0 }
                 };
                 if ss == 1 {
@@ -295,7 +366,11 @@ impl Environment {
         });
         let lum: Vec<f32> = cells.iter().map(|c| c.0).collect();
         let first = lum[0];
-        if lum.iter().all(|&l| l == first) {
+        if let Some(s) = &guided {
+            env.sun = Some(SunCone::new(s));
+            env.integral += luminance(s.power);
+        }
+        if lum.iter().all(|&l| l == first) && env.sun.is_none() {
             env.integral = if first.is_finite() {
                 first * 4.0 * PI
             } else {
@@ -314,10 +389,10 @@ impl Environment {
                 l * sin_t
             })
             .collect();
-        env.integral =
+        env.integral +=
             (integral * 2.0 * std::f64::consts::PI * std::f64::consts::PI / (w * h) as f64) as f32;
         env.dist = Distribution2D::new(w, h, func).map(Box::new);
-        if env.dist.is_none() {
+        if env.dist.is_none() && env.sun.is_none() {
             env.integral = 0.0;
         }
         env
@@ -348,6 +423,15 @@ impl Environment {
     /// Solid-angle density of direction `d` (renderer world, unit).
     #[inline]
     pub fn pdf_dir(&self, d: Vec3) -> f32 {
+        match &self.sun {
+            None => self.map_pdf(d),
+            Some(sun) => SUN_FRACTION * sun.pdf(d) + (1.0 - SUN_FRACTION) * self.map_pdf(d),
+        }
+    }
+
+    /// Solid-angle density of the map's sampling (uniform without a map).
+    #[inline]
+    fn map_pdf(&self, d: Vec3) -> f32 {
         let Some(dist) = &self.dist else {
             return square_to_uniform_sphere_pdf();
         };
@@ -368,25 +452,26 @@ impl Environment {
 }
 
 impl Emitter for Environment {
-    fn sample(&self, scene: &Scene, rec: &mut EmitterQueryRecord, u: Vec2) -> Vec3 {
+    fn sample(&self, scene: &Scene, rec: &mut EmitterQueryRecord, mut u: Vec2) -> Vec3 {
         rec.dist = f32::INFINITY;
-        (rec.wi, rec.pdf) = match &self.dist {
-            Some(dist) => {
-                // The density the point was drawn with, over the map's Jacobian `2π² sin θ`
-                // `pdf_dir` of the direction without going back through atan2 to find its cell.
-                let (p, density) = dist.sample(u);
-                let wi = cell_direction(p.x, p.y);
-                let b = to_blender(wi);
-                let sin_theta = (b.x * b.x + b.y * b.y).sqrt();
-                let pdf = if sin_theta > 0.0 {
-                    density / (2.0 * PI * PI * sin_theta)
-                } else {
-                    0.0
-                };
-                (wi, pdf)
+        if let Some(sun) = &self.sun {
+            // One strategy by u.x, which is then stretched back over [0, 1); the density is
+            // the mixture's, so MIS with BSDF sampling sees one light.
+            if u.x < SUN_FRACTION {
+                u.x /= SUN_FRACTION;
+                rec.wi = sun.sample(u);
+            } else {
+                u.x = ((u.x - SUN_FRACTION) / (1.0 - SUN_FRACTION)).min(1.0 - f32::EPSILON);
+                rec.wi = self.sample_map(u).0;
             }
-            None => (square_to_uniform_sphere(u), square_to_uniform_sphere_pdf()),
-        };
+            rec.pdf = self.pdf_dir(rec.wi);
+            if !(rec.pdf > 0.0 && rec.pdf.is_finite()) {
+                rec.pdf = 0.0;
+                return Vec3::ZERO;
+            }
+            return self.light_radiance(scene, rec.wi) / rec.pdf;
+        }
+        (rec.wi, rec.pdf) = self.sample_map(u);
         if !(rec.pdf > 0.0 && rec.pdf.is_finite()) {
             rec.pdf = 0.0;
             return Vec3::ZERO;
@@ -408,6 +493,30 @@ impl Emitter for Environment {
 
     fn is_delta(&self) -> bool {
         false
+    }
+}
+
+impl Environment {
+    /// A direction from the map (uniform without one) and the map's density for it.
+    #[inline]
+    fn sample_map(&self, u: Vec2) -> (Vec3, f32) {
+        match &self.dist {
+            Some(dist) => {
+                // The density the point was drawn with, over the map's Jacobian `2π² sin θ`
+                // `pdf_dir` of the direction without going back through atan2 to find its cell.
+                let (p, density) = dist.sample(u);
+                let wi = cell_direction(p.x, p.y);
+                let b = to_blender(wi);
+                let sin_theta = (b.x * b.x + b.y * b.y).sqrt();
+                let pdf = if sin_theta > 0.0 {
+                    density / (2.0 * PI * PI * sin_theta)
+                } else {
+                    0.0
+                };
+                (wi, pdf)
+            }
+            None => (square_to_uniform_sphere(u), square_to_uniform_sphere_pdf()),
+        }
     }
 }
 
@@ -557,6 +666,75 @@ mod tests {
                 assert_eq!(sample_cdf(&cdf, &guide, u).0, whole, "n {n} g {g} u {u}");
             }
         }
+    }
+
+    /// A scene whose world is a Sky Texture into a Background.
+    fn sky_scene(sky_type: &str, elevation_deg: f32) -> Scene {
+        let mut g = Graph::default();
+        g.add(
+            crate::shading::Node::new("ShaderNodeTexSky")
+                .prop("sky_type", serde_json::json!(sky_type))
+                .prop(
+                    "sun_elevation",
+                    serde_json::json!(elevation_deg.to_radians()),
+                )
+                .prop("sun_rotation", serde_json::json!(0.7)),
+        );
+        g.add(crate::shading::Node::new("ShaderNodeBackground").link("Color", 0, "Color"));
+        g.surface = Some((1, "Background".into()));
+        let mut scene = Scene::default();
+        scene.world.graph = Some(g);
+        scene
+    }
+
+    #[test]
+    fn a_guided_sun_is_sampled_in_its_cone_and_the_mixture_density_is_consistent() {
+        let scene = sky_scene("MULTIPLE_SCATTERING", 30.0);
+        let graph = scene.world.graph.as_ref().unwrap();
+        let Suns::Guided(sun) = sky::suns(graph) else {
+            panic!("one plain sun is guided");
+        };
+        let res = map_resolution(&scene.world, graph, &scene.images);
+        assert_eq!(res, Some([512, 256, 1]));
+        let program = crate::shading::compile(graph, "w").unwrap().program;
+        let env = Environment::new(&scene, Arc::new(program), Mat4::IDENTITY, res);
+        let cone = env.sun.expect("sun cone");
+        // The map left the disc out: its density at the sun is the sky's, not the sun's.
+        let d = from_blender(sun.dir);
+        assert!(env.map_pdf(d) < 50.0, "{}", env.map_pdf(d));
+        // E[1/pdf] = 4π (the density is positive everywhere: the ground's sky is lit too), and
+        // E[1_cone/pdf] = the cone's solid angle; a density that is not the mixture's fails.
+        let omega = 2.0 * PI * (1.0 - cone.cos_max);
+        let n = 256;
+        let (mut all, mut inside, mut hits) = (0.0f64, 0.0f64, 0usize);
+        for i in 0..n {
+            for j in 0..n {
+                let u = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                let mut rec = EmitterQueryRecord::default();
+                let l = env.sample(&scene, &mut rec, u);
+                assert!(rec.pdf > 0.0 && l.is_finite(), "{u} {}", rec.pdf);
+                assert!((rec.pdf - env.pdf_dir(rec.wi)).abs() <= 1e-3 * rec.pdf);
+                all += 1.0 / rec.pdf as f64;
+                if cone.pdf(rec.wi) > 0.0 {
+                    inside += 1.0 / rec.pdf as f64;
+                    hits += 1;
+                }
+            }
+        }
+        let m = (n * n) as f64;
+        assert!(
+            (all / m / (4.0 * std::f64::consts::PI) - 1.0).abs() < 0.02,
+            "{}",
+            all / m
+        );
+        assert!(
+            (inside / m / omega as f64 - 1.0).abs() < 0.02,
+            "{} {omega}",
+            inside / m
+        );
+        assert!(hits as f64 > 0.79 * m, "{hits}");
+        // The light's power counts the sun.
+        assert!(env.integral > luminance(sun.power));
     }
 
     #[test]

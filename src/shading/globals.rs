@@ -29,6 +29,9 @@ pub mod ray {
     pub const SINGULAR: u32 = 16;
     pub const REFLECTION: u32 = 32;
     pub const TRANSMISSION: u32 = 64;
+    /// Not a Light Path bit: the world is being evaluated for its importance map, which leaves
+    /// out a sun disc that is sampled apart (Cycles' `PATH_RAY_IMPORTANCE_BAKE`).
+    pub const IMPORTANCE_BAKE: u32 = 128;
 }
 
 /// Scene data a program may look up.

@@ -6,7 +6,7 @@
 //! - [`program`]: the operations and their evaluation; [`globals`]: what a shading point knows.
 //! - [`closure`]: what a program produces; [`nodes`]: one file per node family; [`tex`]: the
 //!   procedural textures' algorithms.
-//! - [`preset`]: glTF metallic-roughness as a graph.
+//! - [`preset`]: glTF metallic-roughness as a graph; [`sky`]: the Sky Texture's atmosphere.
 
 pub mod closure;
 pub mod compile;
@@ -15,6 +15,7 @@ pub mod graph;
 pub mod nodes;
 pub mod preset;
 pub mod program;
+pub mod sky;
 pub mod tex;
 
 pub use closure::{Closure, ClosureKind, ClosureSet, Principled};
@@ -127,7 +128,8 @@ mod tests {
 
         let g = graph(json!({
             "nodes": [
-                {"type": "ShaderNodeTexSky", "name": "Sky", "inputs": {}},
+                {"type": "ShaderNodeTexSky", "name": "Sky", "props": {"sky_type": "HOSEK_WILKIE"},
+                 "inputs": {}},
                 {"type": "ShaderNodeFancy", "name": "Fancy", "inputs": {"Color": [0.2, 0.3, 0.4, 1.0]},
                  "internal_links": {"Color": "Color"}},
                 {"type": "ShaderNodeEmission", "inputs": {"Color": {"link": [1, "Color"]},

@@ -57,6 +57,7 @@ pub enum Op {
     Bump(nodes::bump::BumpOp),
     Displacement(nodes::displacement::DisplacementOp),
     Environment(nodes::environment::EnvironmentOp),
+    Sky(nodes::sky::SkyOp),
 }
 
 impl Op {
@@ -75,6 +76,7 @@ impl Op {
             Op::Bump(op) => op.eval(s, g),
             Op::Displacement(op) => op.eval(s, g),
             Op::Environment(op) => op.eval(s, env),
+            Op::Sky(op) => op.eval(s, g),
         }
     }
 }

@@ -1,6 +1,7 @@
 """Run inside Blender 3.4 (test_material_graph.py::test_blender34_graph_uses_5x_vocabulary):
 materials made of 3.x nodes (Principled v1, MixRGB, Separate RGB, Musgrave, Glossy Sharp, Velvet,
-a 3.x Noise), a node group, a muted node and a reroute, exported with the add-on.
+a 3.x Noise), a node group, a muted node and a reroute, and a world with a Nishita sky, exported
+with the add-on.
 
     blender -b --factory-startup --addons tesela --python blender34_material_graph.py -- OUT.gltf
 """
@@ -133,6 +134,22 @@ t.image = hdr
 nt.links.new(t.outputs["Color"], em.inputs["Color"])
 nt.links.new(em.outputs[0], out.inputs["Surface"])
 plane("LegacyHDR", mat, x=6.0)
+
+# A world lit by 3.x's Nishita sky (5.0: single scattering; "dust" became "aerosol").
+world = bpy.data.worlds.new("Legacy Sky")
+world.use_nodes = True
+wnt = world.node_tree
+for n in list(wnt.nodes):
+    wnt.nodes.remove(n)
+sky = wnt.nodes.new("ShaderNodeTexSky")
+sky.name = "Nishita Sky"
+sky.sky_type = "NISHITA"
+sky.dust_density = 2.5
+sky.sun_elevation = 0.5
+bg = wnt.nodes.new("ShaderNodeBackground")
+wnt.links.new(sky.outputs["Color"], bg.inputs["Color"])
+wnt.links.new(bg.outputs[0], wnt.nodes.new("ShaderNodeOutputWorld").inputs["Surface"])
+scene.world = world
 
 assert bpy.ops.export_scene.tesela_gltf(filepath=out_path) == {"FINISHED"}
 print("TESELA_GRAPH_EXPORTED", out_path)

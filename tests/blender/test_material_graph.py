@@ -1175,6 +1175,13 @@ def test_blender34_graph_uses_5x_vocabulary(tmp_path):
     assert "TANGENT" in prim["attributes"]
     assert prim["extras"]["tesela_uv_names"] == ["UVMap", "Second"]
 
+    wg = doc["extensions"]["TESELA_world"]["graph"]
+    _, sky = node(wg, "Nishita Sky")
+    assert sky["props"]["sky_type"] == "SINGLE_SCATTERING"
+    assert sky["props"]["aerosol_density"] == pytest.approx(2.5)
+    assert "dust_density" not in sky["props"]
+    assert sky["props"]["sun_elevation"] == pytest.approx(0.5)
+
     g = graph_of(doc, "Legacy Textures")
     _, mus = node(g, "Musgrave Texture")
     assert mus["type"] == "ShaderNodeTexNoise"

@@ -2,7 +2,7 @@
 //! visibility and importance-sampling settings (docs/extensions.md). Problems with the graph
 //! are reported and fall back, never fail the load: a graph that does not parse renders as the
 //! constant colour, an image that cannot be read as Cycles renders a missing one (magenta), a
-//! Sky Texture (not rendered) as the world's colour.
+//! Sky Texture of the Hosek-Wilkie model (not rendered) as the world's colour.
 
 use super::{Loader, member, num, rgb};
 use crate::scene::WorldSampling;
@@ -60,12 +60,12 @@ impl Loader<'_> {
         let fallback = color.max(Vec3::ZERO);
         for i in 0..graph.nodes.len() {
             let node = &graph.nodes[i];
-            if node.kind == "ShaderNodeTexSky" {
-                let sky = node
-                    .props
-                    .get("sky_type")
-                    .and_then(Value::as_str)
-                    .unwrap_or("MULTIPLE_SCATTERING");
+            let sky = node
+                .props
+                .get("sky_type")
+                .and_then(Value::as_str)
+                .unwrap_or("MULTIPLE_SCATTERING");
+            if node.kind == "ShaderNodeTexSky" && !crate::shading::nodes::sky::is_rendered(sky) {
                 let msg = format!(
                     "world '{name}': node '{}' (ShaderNodeTexSky): the {sky} sky model is not \
                      rendered; it reads as the world's colour {:?}",

@@ -13,6 +13,7 @@ pub mod map_range;
 pub mod math;
 pub mod mix;
 pub mod ramp;
+pub mod sky;
 pub mod texture;
 pub mod transform;
 pub mod utility;
@@ -36,6 +37,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         displacement::compile,
         convert::compile,
         environment::compile,
+        sky::compile,
     ] {
         if family(kind, cx)? {
             return Ok(true);
