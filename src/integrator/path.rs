@@ -1,10 +1,12 @@
 //! Unidirectional path tracing: `path_mats` (BSDF sampling only) and `path_mis` (emitter and
 //! BSDF sampling at every vertex, power heuristic). Russian roulette from vertex 4 on, on the
-//! throughput's **maximum** component, survival probability capped at 0.95.
+//! throughput's **maximum** component, survival probability capped at 0.95. A vertex whose
+//! chosen closure scatters below the surface walks ([`subsurface`]) and goes on from the
+//! exit point at the same depth, lit and sampled there as a diffuse vertex.
 
 use super::light_paths::{BounceCount, LightPaths};
 use super::light_split::{ClassWeights, Sink, SplitsLight};
-use super::{ShadingPoint, mis_weight, sample_emitter_towards, spawn, trace_lit};
+use super::{ShadingPoint, mis_weight, sample_emitter_towards, spawn, subsurface, trace_lit};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
@@ -66,6 +68,7 @@ impl SplitsLight for PathMats {
         let mut transparent = 0;
         let (mut counts, mut end) = (BounceCount::default(), self.max_depth);
         ctx.no_caustics = self.paths.no_caustics();
+        ctx.walks_subsurface = true;
         loop {
             let last = depth >= end;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
@@ -100,7 +103,26 @@ impl SplitsLight for PathMats {
                 o = spawn(&its, d);
                 continue;
             }
-            let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
+            // `dv`: the direction the vertex is seen along (from outside, after a walk).
+            let (its, sp, dv) = match sp.subsurface {
+                None => (its, sp, d),
+                Some(b) => {
+                    let Some((exit, dv)) =
+                        subsurface::scatter(scene, ctx, &its, d, &sp, &b, &mut throughput)
+                    else {
+                        return l;
+                    };
+                    if S::ACTIVE && depth == 1 {
+                        // Cycles counts light through a walk as diffuse.
+                        weights = ClassWeights {
+                            diffuse: Vec3::ONE,
+                            glossy: Vec3::ZERO,
+                        };
+                    }
+                    (exit, ShadingPoint::subsurface_exit(&exit, dv), dv)
+                }
+            };
+            let Some((wo, w, rec)) = sp.sample(ctx, &its, dv) else {
                 return l;
             };
             if S::ACTIVE && depth == 1 {
@@ -138,6 +160,7 @@ impl SplitsLight for PathMis {
         let mut bsdf_pdf = f32::INFINITY;
         let (mut counts, mut end) = (BounceCount::default(), self.max_depth);
         ctx.no_caustics = self.paths.no_caustics();
+        ctx.walks_subsurface = true;
         loop {
             let last = depth >= end;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, bsdf_pdf);
@@ -176,8 +199,27 @@ impl SplitsLight for PathMis {
                 o = spawn(&its, d);
                 continue;
             }
+            // `dv`: the direction the vertex is seen along (from outside, after a walk).
+            let (its, sp, dv) = match sp.subsurface {
+                None => (its, sp, d),
+                Some(b) => {
+                    let Some((exit, dv)) =
+                        subsurface::scatter(scene, ctx, &its, d, &sp, &b, &mut throughput)
+                    else {
+                        return l;
+                    };
+                    if S::ACTIVE && depth == 1 {
+                        // Cycles counts light through a walk as diffuse.
+                        weights = ClassWeights {
+                            diffuse: Vec3::ONE,
+                            glossy: Vec3::ZERO,
+                        };
+                    }
+                    (exit, ShadingPoint::subsurface_exit(&exit, dv), dv)
+                }
+            };
             if !sp.bsdf_is_delta() {
-                let (e, towards) = sample_emitter_towards(scene, ctx, &its, &sp, d, true);
+                let (e, towards) = sample_emitter_towards(scene, ctx, &its, &sp, dv, true);
                 let ls = self.paths.clamp(throughput * e, depth == 1);
                 l += ls;
                 if S::ACTIVE && ls != Vec3::ZERO {
@@ -188,7 +230,7 @@ impl SplitsLight for PathMis {
                     }
                 }
             }
-            let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
+            let Some((wo, w, rec)) = sp.sample(ctx, &its, dv) else {
                 return l;
             };
             if S::ACTIVE && depth == 1 {
