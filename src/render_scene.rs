@@ -708,19 +708,21 @@ impl RenderScene {
     }
 
     /// The closest surface of one object — mesh `mesh` placed by `instance` — along the unit
-    /// direction `d` from `o`, nearer than `tmax` (Cycles' local intersection, for walks
+    /// direction `d` from `o`, in `(tmin, tmax)` (Cycles' local intersection, for walks
     /// inside that object): other objects' surfaces on the way are stepped over, up to
     /// [`MAX_LOCAL_SKIPS`] of them.
+    #[allow(clippy::too_many_arguments)]
     pub fn intersect_local(
         &self,
         ctx: &mut Ctx,
         o: Vec3,
         d: Vec3,
+        tmin: f32,
         tmax: f32,
         mesh: u32,
         instance: u32,
     ) -> Option<Intersection> {
-        let mut tmin = 0.0;
+        let mut tmin = tmin;
         for _ in 0..MAX_LOCAL_SKIPS {
             ctx.cast(o, d, tmax, RayKind::Closest);
             let hit = self.closest_after(ctx, o, d, tmin, tmax)?;
