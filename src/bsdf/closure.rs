@@ -171,7 +171,11 @@ pub fn from_closure_without_caustics(c: &Closure, u: f32, off: u8) -> Option<Bsd
 /// The dielectric base's diffuse keeps `1 - subsurface_weight` of the base colour: the rest
 /// is the subsurface closure's, which the caller walks (or sets to zero to render as diffuse).
 fn principled(p: &Principled, u: f32) -> BsdfInstance {
-    let diffuse = p.base_color * (1.0 - p.subsurface_weight.clamp(0.0, 1.0));
+    let diffuse = if p.subsurface_weight > 0.0 {
+        p.base_color * (1.0 - p.subsurface_weight.min(1.0))
+    } else {
+        p.base_color
+    };
     let r = p.roughness.clamp(0.0, 1.0);
     let alpha = r * r;
     let (ax, ay) = anisotropy::principled(r, p.anisotropic);

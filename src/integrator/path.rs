@@ -103,9 +103,11 @@ impl SplitsLight for PathMats {
                 o = spawn(&its, d);
                 continue;
             }
-            // `dv`: the direction the vertex is seen along (from outside, after a walk).
+            // `dv`: the direction the vertex is seen along (from outside, after a walk). By
+            // reference: moving the shading point would copy it at every vertex.
+            let walked;
             let (its, sp, dv) = match sp.subsurface {
-                None => (its, sp, d),
+                None => (&its, &sp, d),
                 Some(b) => {
                     let Some((exit, dv)) =
                         subsurface::scatter(scene, ctx, &its, d, &sp, &b, &mut throughput)
@@ -119,10 +121,11 @@ impl SplitsLight for PathMats {
                             glossy: Vec3::ZERO,
                         };
                     }
-                    (exit, ShadingPoint::subsurface_exit(&exit, dv), dv)
+                    walked = (exit, ShadingPoint::subsurface_exit(&exit, dv));
+                    (&walked.0, &walked.1, dv)
                 }
             };
-            let Some((wo, w, rec)) = sp.sample(ctx, &its, dv) else {
+            let Some((wo, w, rec)) = sp.sample(ctx, its, dv) else {
                 return l;
             };
             if S::ACTIVE && depth == 1 {
@@ -133,7 +136,7 @@ impl SplitsLight for PathMats {
             if counts.count(ctx.ray_flags, &self.paths) {
                 end = end.min(depth + 1);
             }
-            o = spawn(&its, wo);
+            o = spawn(its, wo);
             d = wo;
             depth += 1;
         }
@@ -199,9 +202,11 @@ impl SplitsLight for PathMis {
                 o = spawn(&its, d);
                 continue;
             }
-            // `dv`: the direction the vertex is seen along (from outside, after a walk).
+            // `dv`: the direction the vertex is seen along (from outside, after a walk). By
+            // reference: moving the shading point would copy it at every vertex.
+            let walked;
             let (its, sp, dv) = match sp.subsurface {
-                None => (its, sp, d),
+                None => (&its, &sp, d),
                 Some(b) => {
                     let Some((exit, dv)) =
                         subsurface::scatter(scene, ctx, &its, d, &sp, &b, &mut throughput)
@@ -215,11 +220,12 @@ impl SplitsLight for PathMis {
                             glossy: Vec3::ZERO,
                         };
                     }
-                    (exit, ShadingPoint::subsurface_exit(&exit, dv), dv)
+                    walked = (exit, ShadingPoint::subsurface_exit(&exit, dv));
+                    (&walked.0, &walked.1, dv)
                 }
             };
             if !sp.bsdf_is_delta() {
-                let (e, towards) = sample_emitter_towards(scene, ctx, &its, &sp, dv, true);
+                let (e, towards) = sample_emitter_towards(scene, ctx, its, sp, dv, true);
                 let ls = self.paths.clamp(throughput * e, depth == 1);
                 l += ls;
                 if S::ACTIVE && ls != Vec3::ZERO {
@@ -230,7 +236,7 @@ impl SplitsLight for PathMis {
                     }
                 }
             }
-            let Some((wo, w, rec)) = sp.sample(ctx, &its, dv) else {
+            let Some((wo, w, rec)) = sp.sample(ctx, its, dv) else {
                 return l;
             };
             if S::ACTIVE && depth == 1 {
@@ -246,7 +252,7 @@ impl SplitsLight for PathMis {
             if counts.count(ctx.ray_flags, &self.paths) {
                 end = end.min(depth + 1);
             }
-            o = spawn(&its, wo);
+            o = spawn(its, wo);
             d = wo;
             depth += 1;
         }

@@ -110,7 +110,18 @@ fn walk_share(ss: f32, a: f32) -> f32 {
 /// The split of closure `c` when it scatters below the surface; `None` when it does not.
 /// Where the integrator does not walk (`walks` false) or the radius is too small to walk,
 /// `p` is 0 and `rest` renders it all as diffuse.
+#[inline(always)]
 pub fn split(c: &Closure, walks: bool) -> Option<Split> {
+    // The common case, without a call.
+    match &c.kind {
+        ClosureKind::Principled(p) if p.cycles && p.subsurface_weight > 0.0 => split_cold(c, walks),
+        ClosureKind::Subsurface { .. } => split_cold(c, walks),
+        _ => None,
+    }
+}
+
+#[inline(never)]
+fn split_cold(c: &Closure, walks: bool) -> Option<Split> {
     let none = |rest: Closure| Split {
         p: 0.0,
         bssrdf: Bssrdf {
@@ -195,75 +206,40 @@ pub fn single_scatter_albedo(color: f32, g: f32) -> f32 {
     // Horner form of Σ k_i g^i.
     let poly = |k: [f32; 8]| k.iter().rev().fold(0.0, |acc, &ki| acc * g + ki);
     let a = poly([
-        1.826_052_4,
-        -1.284_510_6,
-        -1.799_046_3,
-        9.193_933,
-        -22.821_558,
-        32.023_487,
-        -23.626_48,
-        7.210_67,
+        1.8260524, -1.2845106, -1.7990463, 9.193933, -22.821558, 32.023487, -23.62648, 7.21067,
     ]);
-    let b = 4.985_112
-        + 0.127_355_96
+    let b = 4.985112
+        + 0.12735596
             * poly([
-                0.0,
-                31.149_158,
-                -201.847_02,
-                841.576,
-                -2018.092_9,
-                2731.715_6,
-                -1935.414_2,
-                559.009_05,
+                0.0, 31.149158, -201.84702, 841.576, -2018.0929, 2731.7156, -1935.4142, 559.00905,
             ])
             .exp();
     let cc = poly([
-        1.096_861,
-        -0.394_704_06,
-        1.052_581_2,
-        -8.839_637,
-        28.864_323,
-        -46.880_29,
-        38.540_283,
-        -12.718_104,
+        1.096861,
+        -0.39470406,
+        1.0525812,
+        -8.839637,
+        28.864323,
+        -46.88029,
+        38.540283,
+        -12.718104,
     ]);
     let d = poly([
-        0.496_310_2,
-        0.360_146_58,
-        -2.151_393,
-        17.889_69,
-        -55.298_4,
-        82.065_98,
-        -58.510_6,
-        15.847_83,
+        0.4963102, 0.36014658, -2.151393, 17.88969, -55.2984, 82.06598, -58.5106, 15.84783,
     ]);
-    let e = 4.231_903
-        + 0.003_106_039_5
+    let e = 4.231903
+        + 0.0031060395
             * poly([
-                0.0,
-                76.731_63,
-                -594.356_8,
-                2448.883_4,
-                -5576.685,
-                7116.601_6,
-                -4763.544_7,
-                1303.531_8,
+                0.0, 76.73163, -594.3568, 2448.8834, -5576.685, 7116.6016, -4763.545, 1303.5318,
             ])
             .exp();
     let f = poly([
-        2.406_03,
-        -2.518_148_4,
-        9.184_949,
-        -79.219_17,
-        259.082_87,
-        -403.613_8,
-        302.857_12,
-        -87.437_05,
+        2.40603, -2.5181484, 9.184949, -79.21917, 259.08287, -403.6138, 302.85712, -87.43705,
     ]);
     let blend = c.powf(0.25);
     let alpha = (1.0 - blend) * a * (b * c).atan().powf(cc) + blend * d * (e * c).atan().powf(f);
     if alpha.is_finite() {
-        alpha.clamp(0.0, 0.999_999)
+        alpha.clamp(0.0, 0.999999)
     } else {
         0.0
     }
