@@ -94,6 +94,15 @@ pub fn by_name_with(
     })
 }
 
+/// The warning for a render with integrator `name` of a scene with subsurface materials when
+/// that integrator does not walk them (the direct-only ones render them as diffuse).
+pub fn subsurface_warning(name: &str, scene: &RenderScene) -> Option<String> {
+    let walks = matches!(name, "path_mis" | "path_mats");
+    (!walks && scene.programs.iter().any(|p| p.may_scatter_below())).then(|| {
+        format!("subsurface scattering renders as diffuse with the {name} integrator (path_mis and path_mats walk it)")
+    })
+}
+
 /// Most transparent surfaces a path or shadow ray goes straight through (Cycles' default
 /// `transparent_max_bounces`).
 pub const MAX_TRANSPARENT: u32 = 8;

@@ -447,12 +447,16 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                 cx.warn("thin film is not rendered");
             }
             let ss = "Subsurface Weight";
-            if cx.is_linked(ss) || cx.const_value(ss).is_some_and(|v| v[0] != 0.0) {
+            if !p.cycles {
+                // glTF materials have no subsurface.
+            } else if cx.is_linked(ss) || cx.const_value(ss).is_some_and(|v| v[0] != 0.0) {
+                cx.scatters_below();
                 warn_subsurface_method(cx, "subsurface_method");
             }
             ClosureParams::Principled(Box::new(p))
         }
         "ShaderNodeSubsurfaceScattering" => {
+            cx.scatters_below();
             warn_subsurface_method(cx, "falloff");
             ClosureParams::Subsurface {
                 color: cx.color("Color", Vec3::splat(0.8))?,
