@@ -771,7 +771,11 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
         tile_count: rw.div_ceil(ts) * rh.div_ceil(ts),
         passes,
     });
-    for w in rscene.scene.warnings.iter().chain(&denoise_warning) {
+    let subsurface = tesela::integrator::subsurface_warning(&opts.integrator, &rscene);
+    for w in (rscene.scene.warnings.iter())
+        .chain(&denoise_warning)
+        .chain(&subsurface)
+    {
         send(&Message::Log {
             level: 2,
             message: w.clone(),
@@ -934,7 +938,8 @@ fn run_render(args: &RenderArgs) -> ExitCode {
     let key = split.as_ref().map(|_| render_key(args, &opts));
     let build = std::time::Instant::now();
     let rscene = prepare(scene, light_choice(args), opts.threads);
-    for w in &rscene.scene.warnings {
+    let subsurface = tesela::integrator::subsurface_warning(&opts.integrator, &rscene);
+    for w in rscene.scene.warnings.iter().chain(&subsurface) {
         eprintln!("tesela: warning: {w}");
     }
     if rscene.triangle_count() == 0 {

@@ -54,6 +54,9 @@ impl Intersection {
 /// Emitted radiance met by a ray: `(emitter index, radiance, record for MIS)`.
 pub type Emitted = Option<(u32, Vec3, EmitterQueryRecord)>;
 
+/// Most surfaces of other objects a local ray ([`RenderScene::intersect_local`]) steps over.
+pub const MAX_LOCAL_SKIPS: u32 = 16;
+
 /// Every triangle of the meshes for which `keep(mesh index)` holds, with its key
 /// `[mesh index, triangle index]`, for [`Accel::build_from`].
 fn mesh_triangles<'a>(
@@ -139,6 +142,9 @@ pub struct Ctx {
     /// The least GGX alpha of the microfacet lobes at the next hit the path integrator
     /// shades (Cycles' Filter Glossy, [`crate::integrator::filter_glossy`]); 0 = none.
     pub blur: f32,
+    /// The integrator walks subsurface closures ([`crate::integrator::subsurface`]); without
+    /// it they render as diffuse.
+    pub walks_subsurface: bool,
 }
 
 impl Ctx {
@@ -156,6 +162,7 @@ impl Ctx {
             trav_top: Traversal::default(),
             no_caustics: 0,
             blur: 0.0,
+            walks_subsurface: false,
         }
     }
 
@@ -689,13 +696,46 @@ impl RenderScene {
     /// The closest hit in `(0, tmax)` over the world-space meshes and the instances.
     #[inline(always)]
     fn closest(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32) -> Option<Hit> {
-        let hit = self.accel.intersect_with(&mut ctx.trav, o, d, 0.0, tmax);
+        self.closest_after(ctx, o, d, 0.0, tmax)
+    }
+
+    /// [`Self::closest`] in `(tmin, tmax)`.
+    #[inline(always)]
+    fn closest_after(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
+        let hit = self.accel.intersect_with(&mut ctx.trav, o, d, tmin, tmax);
         let Some(inst) = &self.instances else {
             return hit;
         };
         let t = hit.map_or(tmax, |h| h.t);
-        inst.intersect_with(&mut ctx.trav_top, &mut ctx.trav, o, d, 0.0, t)
+        inst.intersect_with(&mut ctx.trav_top, &mut ctx.trav, o, d, tmin, t)
             .or(hit)
+    }
+
+    /// The closest surface of one object — mesh `mesh` placed by `instance` — along the unit
+    /// direction `d` from `o`, in `(tmin, tmax)` (Cycles' local intersection, for walks
+    /// inside that object): other objects' surfaces on the way are stepped over, up to
+    /// [`MAX_LOCAL_SKIPS`] of them.
+    #[allow(clippy::too_many_arguments)]
+    pub fn intersect_local(
+        &self,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        tmin: f32,
+        tmax: f32,
+        mesh: u32,
+        instance: u32,
+    ) -> Option<Intersection> {
+        let mut tmin = tmin;
+        for _ in 0..MAX_LOCAL_SKIPS {
+            ctx.cast(o, d, tmax, RayKind::Closest);
+            let hit = self.closest_after(ctx, o, d, tmin, tmax)?;
+            if hit.key[0] == mesh && hit.instance == instance {
+                return Some(self.intersection(&hit, d));
+            }
+            tmin = hit.t;
+        }
+        None
     }
 
     /// Whether anything lies on the ray in `(0, tmax)`.
@@ -1040,6 +1080,7 @@ impl RenderScene {
                 | ClosureKind::Refraction { color, .. }
                 | ClosureKind::Translucent { color }
                 | ClosureKind::Transparent { color } => color,
+                ClosureKind::Subsurface { .. } => Vec3::ONE,
             }
     }
 

@@ -239,3 +239,72 @@ fn bump_tilts_the_normal_by_the_height_gradient() {
         );
     }
 }
+
+/// A Principled ball (subsurface weight 1, no specular layer, radius `radius` × scale 1) on
+/// the floor under the light of [`shadow_scene`], seen from above.
+fn subsurface_ball(radius: f32, weight: f32) -> Scene {
+    let mut s = shadow_scene(None);
+    s.camera.as_mut().unwrap().to_world =
+        tesela::scene::builtin::look_at(Vec3::new(0.0, 1.2, 0.9), Vec3::new(0.0, 0.25, 0.0));
+    s.materials.push(graph_material(
+        "ball",
+        json!({"nodes": [{"type": "ShaderNodeBsdfPrincipled", "inputs": {
+                 "Base Color": [0.8, 0.8, 0.8, 1.0], "Specular IOR Level": 0.0,
+                 "Subsurface Weight": weight, "Subsurface Radius": [radius, radius, radius],
+                 "Subsurface Scale": 1.0}}],
+               "surface": [0, "BSDF"]}),
+    ));
+    s.meshes.push(tesela::scene::builtin::sphere(
+        "ball",
+        2,
+        Vec3::new(0.0, 0.25, 0.0),
+        0.25,
+        24,
+        48,
+    ));
+    s
+}
+
+/// Mean over the whole 24×24 image and over its central 8×8 (the ball's lit top).
+fn means(img: &[[f32; 4]]) -> (f32, f32) {
+    let v = |p: &[f32; 4]| (p[0] + p[1] + p[2]) / 3.0;
+    let all = img.iter().map(v).sum::<f32>() / img.len() as f32;
+    let centre = (8..16)
+        .flat_map(|y| (8..16).map(move |x| y * 24 + x))
+        .map(|i| v(&img[i]))
+        .sum::<f32>()
+        / 64.0;
+    (all, centre)
+}
+
+/// The walk runs in the path integrators: with a radius far below the ball's size a
+/// subsurface ball looks like the diffuse one (the walk's albedo is the base colour), with a
+/// radius like its size the lit top loses light to the rest of the ball; the image is the
+/// same for any thread count.
+#[test]
+fn subsurface_walks_in_path_integrators() {
+    let o = opts("path_mis", 24, 64, 6);
+    let diffuse = means(&render(subsurface_ball(0.01, 0.0), &o));
+    let narrow = means(&render(subsurface_ball(0.01, 1.0), &o));
+    let wide = means(&render(subsurface_ball(3.0, 1.0), &o));
+    assert!(
+        (narrow.0 / diffuse.0 - 1.0).abs() < 0.05 && (narrow.1 / diffuse.1 - 1.0).abs() < 0.05,
+        "narrow {narrow:?} vs diffuse {diffuse:?}"
+    );
+    assert!(
+        wide.1 < 0.9 * narrow.1,
+        "wide {wide:?} vs narrow {narrow:?}"
+    );
+    let one = render(
+        subsurface_ball(0.3, 1.0),
+        &RenderOptions {
+            threads: 1,
+            ..o.clone()
+        },
+    );
+    let four = render(
+        subsurface_ball(0.3, 1.0),
+        &RenderOptions { threads: 4, ..o },
+    );
+    assert!(one == four, "thread count changed the image");
+}

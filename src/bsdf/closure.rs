@@ -142,6 +142,8 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
         }
         ClosureKind::Translucent { color } => BsdfInstance::Translucent(Translucent::new(*color)),
         ClosureKind::Transparent { color } => BsdfInstance::Transparent(Transparent::new(*color)),
+        // Where it is not walked, subsurface scattering is diffuse (the colour is the weight).
+        ClosureKind::Subsurface { .. } => BsdfInstance::Diffuse(Diffuse::new(Vec3::ONE)),
     }
 }
 
@@ -212,6 +214,11 @@ pub fn from_closure_without_caustics(
 // Always inlined: without the filter the blur folds away.
 #[inline(always)]
 fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
+    let diffuse = if p.subsurface_weight > 0.0 {
+        p.base_color * (1.0 - p.subsurface_weight.min(1.0))
+    } else {
+        p.base_color
+    };
     let r = p.roughness.clamp(0.0, 1.0);
     let alpha0 = r * r;
     let (ax0, ay0) = anisotropy::principled(r, p.anisotropic);
@@ -247,10 +254,10 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
                 BaseLobe::RoughConductor(if ms_aniso { l.multiscatter() } else { l }.blurred(blur))
             }
         } else if p.specular_level * p.specular_tint.max_element() <= 0.0 {
-            BaseLobe::Diffuse(Diffuse::new(p.base_color))
+            BaseLobe::Diffuse(Diffuse::new(diffuse))
         } else if ax.max(ay) < DELTA_ALPHA {
             BaseLobe::Plastic(Plastic::new(
-                p.base_color,
+                diffuse,
                 alpha,
                 p.ior,
                 2.0 * p.specular_level,
@@ -266,10 +273,7 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
             } else {
                 specular
             };
-            BaseLobe::SpecularDiffuse(Layered::new(
-                specular.blurred(blur),
-                Diffuse::new(p.base_color),
-            ))
+            BaseLobe::SpecularDiffuse(Layered::new(specular.blurred(blur), Diffuse::new(diffuse)))
         }
     };
     let coat = (p.coat_weight > 0.0)
@@ -293,6 +297,32 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
             }
         }
     }
+}
+
+/// `A(wi)`: the share of light arriving from the local direction `wi` (above the closure's
+/// normal) that the Principled BSDF's layers above its dielectric base — specular, coat and
+/// sheen — pass down to it, per channel: the factor on the subsurface closure, as Cycles'
+/// albedo scaling applies it to every closure below a layer. A smooth specular layer is
+/// taken at the least roughness the rough one has.
+pub fn principled_base_attenuation(p: &Principled, wi: Vec3) -> Vec3 {
+    use super::layered::Layer;
+    let r = p.roughness.clamp(0.0, 1.0);
+    let (ax, ay) = anisotropy::principled(r, p.anisotropic);
+    let mut att = Vec3::ONE;
+    if p.specular_level * p.specular_tint.max_element() > 0.0 {
+        let ior = principled_specular_ior(p.ior, p.specular_level);
+        let (ax, ay) = (ax.max(DELTA_ALPHA), ay.max(DELTA_ALPHA));
+        let specular = RoughDielectric::principled_specular(p.specular_tint, ior, ax, ay);
+        att *= Layer::attenuation(&specular.multiscatter(), wi);
+    }
+    if p.coat_weight > 0.0 {
+        let coat = Coat::new(p.coat_weight, p.coat_roughness, p.coat_ior, p.coat_tint);
+        att *= coat.attenuation(wi);
+    }
+    if p.sheen_weight > 0.0 && p.sheen_tint.max_element() > 0.0 {
+        att *= Sheen::new(p.sheen_tint * p.sheen_weight, p.sheen_roughness).attenuation(wi);
+    }
+    att
 }
 
 fn unlayered(b: BaseLobe) -> BsdfInstance {

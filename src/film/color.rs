@@ -44,6 +44,8 @@ pub fn closure_colors(c: &Closure, mu: f32, backfacing: bool) -> [Vec3; 3] {
             put(LightClass::Glossy, g);
             put(LightClass::Transmission, t);
         }
+        // Cycles counts subsurface in the diffuse passes; its colour is in the weight.
+        ClosureKind::Subsurface { .. } => put(LightClass::Diffuse, Vec3::ONE),
         ClosureKind::Transparent { .. } => {}
     }
     out

@@ -37,6 +37,7 @@ fn closure_albedo(c: &Closure) -> Option<Vec3> {
         | ClosureKind::Glass { color, .. }
         | ClosureKind::Refraction { color, .. }
         | ClosureKind::Translucent { color } => color,
+        ClosureKind::Subsurface { .. } => Vec3::ONE,
         ClosureKind::Transparent { .. } => return None,
     };
     Some(c.weight * color)

@@ -201,6 +201,7 @@ mod tests {
             subsurface_weight: 0.0,
             subsurface_radius: Vec3::ONE,
             subsurface_scale: 0.0,
+            subsurface_anisotropy: 0.0,
             cycles: true,
         }
     }

@@ -14,6 +14,7 @@ pub mod light_paths;
 pub mod light_split;
 pub mod path;
 pub mod scaled;
+pub mod subsurface;
 
 use crate::accel::offset_origin;
 use crate::bsdf::{self, Bsdf, BsdfInstance, BsdfQueryRecord};
@@ -94,6 +95,15 @@ pub fn by_name_with(
     })
 }
 
+/// The warning for a render with integrator `name` of a scene with subsurface materials when
+/// that integrator does not walk them (the direct-only ones render them as diffuse).
+pub fn subsurface_warning(name: &str, scene: &RenderScene) -> Option<String> {
+    let walks = matches!(name, "path_mis" | "path_mats");
+    (!walks && scene.programs.iter().any(|p| p.may_scatter_below())).then(|| {
+        format!("subsurface scattering renders as diffuse with the {name} integrator (path_mis and path_mats walk it)")
+    })
+}
+
 /// Most transparent surfaces a path or shadow ray goes straight through (Cycles' default
 /// `transparent_max_bounces`).
 pub const MAX_TRANSPARENT: u32 = 8;
@@ -108,6 +118,9 @@ pub struct ShadingPoint {
     pub wi: Vec3,
     /// The chosen closure's weight divided by the probability of choosing it.
     pub weight: Vec3,
+    /// The path enters the surface here for a subsurface walk (the BSDF is then unused):
+    /// `frame.n` is the BSSRDF's normal and `weight` the walk's.
+    pub subsurface: Option<subsurface::Bssrdf>,
     /// The interpolated normal on the viewer's side when the closure's own normal differs
     /// from it (normal or bump map), for Cycles' bump shadowing; `None` otherwise.
     smooth: Option<Vec3>,
@@ -138,7 +151,18 @@ impl ShadingPoint {
                 0
             };
         let blur = ctx.blur;
+        let walks = ctx.walks_subsurface;
         let (closure, inv_p, u) = scene.choose_closure(ctx, its, d, depth, u)?;
+        let rest;
+        let (closure, u, share) = match subsurface::split(closure, walks) {
+            None => (closure, u, 1.0),
+            Some(s) if u < s.p => return Some(Self::subsurface_entry(its, d, closure, inv_p, &s)),
+            Some(s) => {
+                rest = s.rest;
+                let u = ((u - s.p) / (1.0 - s.p)).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+                (&rest, u, 1.0 / (1.0 - s.p))
+            }
+        };
         let bsdf = if caustics_off == 0 && blur == 0.0 {
             bsdf::from_closure(closure, u)
         } else if caustics_off == 0 {
@@ -246,8 +270,74 @@ impl ShadingPoint {
             bsdf,
             wi,
             frame,
-            weight: closure.weight * inv_p,
+            weight: closure.weight * (inv_p * share),
+            subsurface: None,
         })
+    }
+
+    /// The shading point of a path entering the surface at `its` (seen along the unit `d`)
+    /// for the walk of split `s` of `closure` (chosen with probability `1 / inv_p`): the
+    /// BSSRDF's normal is the closure's (raised as a specular one's, as Cycles does) or the
+    /// interpolated one on the viewer's side; the weight includes what the layers above the
+    /// walk let through from `d`.
+    fn subsurface_entry(
+        its: &Intersection,
+        d: Vec3,
+        closure: &crate::shading::Closure,
+        inv_p: f32,
+        s: &subsurface::Split,
+    ) -> ShadingPoint {
+        let ng = if its.ng.dot(-d) < 0.0 {
+            -its.ng
+        } else {
+            its.ng
+        };
+        let n = if closure.normal == Vec3::ZERO {
+            if its.ns.dot(-d) < 0.0 {
+                -its.ns
+            } else {
+                its.ns
+            }
+        } else {
+            bsdf::closure::valid_specular_normal(ng, -d, closure.normal)
+        };
+        let frame = Frame::from_normal(n);
+        let wi = frame.to_local(-d);
+        let att = s.layers.as_ref().map_or(Vec3::ONE, |p| {
+            bsdf::closure::principled_base_attenuation(p, wi)
+        });
+        ShadingPoint {
+            passes: false,
+            bsdf: BsdfInstance::Diffuse(bsdf::Diffuse::new(Vec3::ZERO)),
+            frame,
+            wi,
+            weight: s.weight * att * inv_p,
+            subsurface: Some(s.bssrdf),
+            smooth: None,
+            glossy_frame: None,
+        }
+    }
+
+    /// The shading point where a walk leaves the surface at `its`, seen along the unit `d`
+    /// (pointing into the surface): a white Lambertian BSDF about the interpolated normal on
+    /// the side the walk left to (Cycles' exit closure; bump maps are not applied there).
+    pub fn subsurface_exit(its: &Intersection, d: Vec3) -> ShadingPoint {
+        let n = if its.ns.dot(-d) < 0.0 {
+            -its.ns
+        } else {
+            its.ns
+        };
+        let frame = Frame::from_normal(n);
+        ShadingPoint {
+            passes: false,
+            bsdf: BsdfInstance::Diffuse(bsdf::Diffuse::new(Vec3::ONE)),
+            frame,
+            wi: frame.to_local(-d),
+            weight: Vec3::ONE,
+            subsurface: None,
+            smooth: None,
+            glossy_frame: None,
+        }
     }
 
     /// The kinds of scattering of the chosen BSDF (Light Path bits `DIFFUSE`, `GLOSSY`,

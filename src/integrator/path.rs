@@ -1,11 +1,13 @@
 //! Unidirectional path tracing: `path_mats` (BSDF sampling only) and `path_mis` (emitter and
 //! BSDF sampling at every vertex, power heuristic). Russian roulette from vertex 4 on, on the
 //! throughput's **maximum** component, survival probability capped at 0.95. Both apply
-//! Cycles' Filter Glossy ([`super::filter_glossy`]) when it is on.
+//! Cycles' Filter Glossy ([`super::filter_glossy`]) when it is on. A vertex whose chosen
+//! closure scatters below the surface walks ([`subsurface`]) and goes on from the exit point
+//! at the same depth, lit and sampled there as a diffuse vertex.
 
 use super::light_paths::{BounceCount, LightPaths};
 use super::light_split::{ClassWeights, Sink, SplitsLight};
-use super::{ShadingPoint, mis_weight, sample_emitter_towards, spawn, trace_lit};
+use super::{ShadingPoint, mis_weight, sample_emitter_towards, spawn, subsurface, trace_lit};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
@@ -89,6 +91,7 @@ impl PathMats {
         // Least BSDF density of the path's non-delta bounces (Filter Glossy).
         let mut min_ray_pdf = f32::INFINITY;
         ctx.blur = 0.0;
+        ctx.walks_subsurface = true;
         loop {
             let last = depth >= end;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
@@ -126,7 +129,29 @@ impl PathMats {
                 o = spawn(&its, d);
                 continue;
             }
-            let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
+            // `dv`: the direction the vertex is seen along (from outside, after a walk). By
+            // reference: moving the shading point would copy it at every vertex.
+            let walked;
+            let (its, sp, dv) = match sp.subsurface {
+                None => (&its, &sp, d),
+                Some(b) => {
+                    let Some((exit, dv)) =
+                        subsurface::scatter(scene, ctx, &its, d, &sp, &b, &mut throughput)
+                    else {
+                        return l;
+                    };
+                    if S::ACTIVE && depth == 1 {
+                        // Cycles counts light through a walk as diffuse.
+                        weights = ClassWeights {
+                            diffuse: Vec3::ONE,
+                            glossy: Vec3::ZERO,
+                        };
+                    }
+                    walked = (exit, ShadingPoint::subsurface_exit(&exit, dv));
+                    (&walked.0, &walked.1, dv)
+                }
+            };
+            let Some((wo, w, rec)) = sp.sample(ctx, its, dv) else {
                 return l;
             };
             if S::ACTIVE && depth == 1 {
@@ -140,7 +165,7 @@ impl PathMats {
             if counts.count(ctx.ray_flags, &self.paths) {
                 end = end.min(depth + 1);
             }
-            o = spawn(&its, wo);
+            o = spawn(its, wo);
             d = wo;
             depth += 1;
         }
@@ -189,6 +214,7 @@ impl PathMis {
         // Least BSDF density of the path's non-delta bounces (Filter Glossy).
         let mut min_ray_pdf = f32::INFINITY;
         ctx.blur = 0.0;
+        ctx.walks_subsurface = true;
         loop {
             let last = depth >= end;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, bsdf_pdf);
@@ -230,8 +256,30 @@ impl PathMis {
                 o = spawn(&its, d);
                 continue;
             }
+            // `dv`: the direction the vertex is seen along (from outside, after a walk). By
+            // reference: moving the shading point would copy it at every vertex.
+            let walked;
+            let (its, sp, dv) = match sp.subsurface {
+                None => (&its, &sp, d),
+                Some(b) => {
+                    let Some((exit, dv)) =
+                        subsurface::scatter(scene, ctx, &its, d, &sp, &b, &mut throughput)
+                    else {
+                        return l;
+                    };
+                    if S::ACTIVE && depth == 1 {
+                        // Cycles counts light through a walk as diffuse.
+                        weights = ClassWeights {
+                            diffuse: Vec3::ONE,
+                            glossy: Vec3::ZERO,
+                        };
+                    }
+                    walked = (exit, ShadingPoint::subsurface_exit(&exit, dv));
+                    (&walked.0, &walked.1, dv)
+                }
+            };
             if !sp.bsdf_is_delta() {
-                let (e, towards) = sample_emitter_towards(scene, ctx, &its, &sp, d, true);
+                let (e, towards) = sample_emitter_towards(scene, ctx, its, sp, dv, true);
                 let ls = self.paths.clamp(throughput * e, depth == 1);
                 l += ls;
                 if S::ACTIVE && ls != Vec3::ZERO {
@@ -242,7 +290,7 @@ impl PathMis {
                     }
                 }
             }
-            let Some((wo, w, rec)) = sp.sample(ctx, &its, d) else {
+            let Some((wo, w, rec)) = sp.sample(ctx, its, dv) else {
                 return l;
             };
             if S::ACTIVE && depth == 1 {
@@ -261,7 +309,7 @@ impl PathMis {
             if counts.count(ctx.ray_flags, &self.paths) {
                 end = end.min(depth + 1);
             }
-            o = spawn(&its, wo);
+            o = spawn(its, wo);
             d = wo;
             depth += 1;
         }

@@ -29,9 +29,13 @@ pub struct Principled {
     pub sheen_weight: f32,
     pub sheen_roughness: f32,
     pub sheen_tint: Vec3,
+    /// Share of the dielectric base that scatters below the surface (the rest is diffuse).
     pub subsurface_weight: f32,
+    /// Mean free path per channel, in units of `subsurface_scale`.
     pub subsurface_radius: Vec3,
     pub subsurface_scale: f32,
+    /// Henyey–Greenstein `g` inside.
+    pub subsurface_anisotropy: f32,
     /// Blender's Principled (F82 metals, multiple-scattering GGX, coat and sheen layers);
     /// false for glTF materials, which keep their Schlick metal and single-scattering GGX.
     pub cycles: bool,
@@ -62,6 +66,7 @@ impl Principled {
             subsurface_weight: 0.0,
             subsurface_radius: Vec3::ONE,
             subsurface_scale: 0.0,
+            subsurface_anisotropy: 0.0,
             cycles: true,
         }
     }
@@ -100,6 +105,16 @@ pub enum ClosureKind {
     /// Lambertian transmission.
     Translucent {
         color: Vec3,
+    },
+    /// Subsurface scattering (Blender's Subsurface Scattering node): a random walk below the
+    /// surface; its colour is in the closure's weight, and also its albedo here.
+    Subsurface {
+        albedo: Vec3,
+        /// Mean free path per channel, world units (Radius × Scale).
+        radius: Vec3,
+        ior: f32,
+        roughness: f32,
+        anisotropy: f32,
     },
     /// Straight pass-through.
     Transparent {

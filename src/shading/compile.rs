@@ -73,6 +73,7 @@ pub struct Compiler<'g> {
     warnings: Vec<String>,
     may_emit: bool,
     may_pass: bool,
+    may_scatter_below: bool,
     /// Whether any operation depends on the shading point (else the closures are constant).
     varying: bool,
     /// A displacement replaced `N`: closures without a Normal input take the displaced one.
@@ -99,6 +100,7 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
         warnings: Vec::new(),
         may_emit: false,
         may_pass: false,
+        may_scatter_below: false,
         varying: false,
         displaced: false,
     };
@@ -115,6 +117,7 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
         constant: None,
         may_emit: c.may_emit,
         may_pass: c.may_pass,
+        may_scatter_below: c.may_scatter_below,
     };
     if !c.varying {
         // Closure operations read only constant slots: run once now.
@@ -482,6 +485,11 @@ impl<'g> NodeCx<'_, 'g> {
     /// Marks the program as possibly emitting.
     pub fn emits(&mut self) {
         self.c.may_emit = true;
+    }
+
+    /// Marks the program as possibly scattering below the surface (a subsurface closure).
+    pub fn scatters_below(&mut self) {
+        self.c.may_scatter_below = true;
     }
 
     /// Marks the program as possibly letting light straight through (a transparent closure).

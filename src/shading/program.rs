@@ -94,6 +94,8 @@ pub struct Program {
     /// Whether a transparent closure can come out of the program (shadow rays must then
     /// look through the surface).
     pub(crate) may_pass: bool,
+    /// Whether a subsurface closure can come out of the program.
+    pub(crate) may_scatter_below: bool,
 }
 
 impl Program {
@@ -169,6 +171,11 @@ impl Program {
     /// True when the program may emit light somewhere.
     pub fn may_emit(&self) -> bool {
         self.may_emit
+    }
+
+    /// True when the surface may scatter light below itself somewhere (subsurface).
+    pub fn may_scatter_below(&self) -> bool {
+        self.may_scatter_below
     }
 
     /// True when the surface may be partly transparent somewhere.

@@ -51,6 +51,7 @@ pub struct PrincipledSlots {
     subsurface_weight: Slot,
     subsurface_radius: Slot,
     subsurface_scale: Slot,
+    subsurface_anisotropy: Slot,
     emission_color: Slot,
     emission_strength: Slot,
     cycles: bool,
@@ -112,6 +113,16 @@ pub enum ClosureParams {
     },
     Transparent {
         color: Slot,
+    },
+    /// The Subsurface Scattering node.
+    Subsurface {
+        color: Slot,
+        scale: Slot,
+        radius: Slot,
+        ior: Slot,
+        roughness: Slot,
+        anisotropy: Slot,
+        normal: Option<Slot>,
     },
     Emission {
         color: Slot,
@@ -223,6 +234,7 @@ impl ClosureOp {
                     subsurface_weight: s.f(p.subsurface_weight).clamp(0.0, 1.0),
                     subsurface_radius: col(p.subsurface_radius),
                     subsurface_scale: s.f(p.subsurface_scale).max(0.0),
+                    subsurface_anisotropy: s.f(p.subsurface_anisotropy),
                     cycles: p.cycles,
                 };
                 push(
@@ -359,6 +371,30 @@ impl ClosureOp {
                 Vec3::ZERO,
                 ClosureKind::Transparent { color: Vec3::ONE },
             ),
+            ClosureParams::Subsurface {
+                color,
+                scale,
+                radius,
+                ior,
+                roughness,
+                anisotropy,
+                normal: n,
+            } => {
+                let c = col(*color);
+                push(
+                    out,
+                    c * w,
+                    normal(*n),
+                    Vec3::ZERO,
+                    ClosureKind::Subsurface {
+                        albedo: c.min(Vec3::ONE),
+                        radius: (col(*radius) * s.f(*scale)).max(Vec3::ZERO),
+                        ior: s.f(*ior),
+                        roughness: s.f(*roughness),
+                        anisotropy: s.f(*anisotropy),
+                    },
+                );
+            }
             ClosureParams::Emission { color, strength } => {
                 out.add_emission(col(*color) * s.f(*strength) * w);
             }
@@ -389,6 +425,23 @@ fn world_normal(n: Vec3, _g: &ShaderGlobals) -> Vec3 {
         v / l
     } else {
         Vec3::ZERO
+    }
+}
+
+/// Warns where the subsurface method (enum property `prop`) is one Tesela renders as the
+/// plain random walk.
+fn warn_subsurface_method(cx: &mut NodeCx, prop: &str) {
+    match cx.prop_str(prop).unwrap_or("RANDOM_WALK") {
+        "RANDOM_WALK" => {}
+        "RANDOM_WALK_SKIN" => cx.warn(
+            "Random Walk (Skin) subsurface renders as Random Walk (no diffuse entry, no radius \
+             fit to the albedo)",
+        ),
+        "BURLEY" => cx.warn(
+            "Christensen-Burley subsurface renders as Random Walk (a volumetric walk, not \
+             Cycles' disk sampling: softer, more translucent)",
+        ),
+        _ => cx.warn("unknown subsurface method renders as Random Walk"),
     }
 }
 
@@ -461,6 +514,7 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                 subsurface_weight: f(cx, "Subsurface Weight", 0.0)?,
                 subsurface_radius: cx.vector("Subsurface Radius", Vec3::new(1.0, 0.2, 0.1))?,
                 subsurface_scale: f(cx, "Subsurface Scale", 0.05)?,
+                subsurface_anisotropy: f(cx, "Subsurface Anisotropy", 0.0)?,
                 emission_color: c(cx, "Emission Color", Vec3::ONE)?,
                 emission_strength: f(cx, "Emission Strength", 0.0)?,
                 cycles: !cx.prop_bool("gltf", false),
@@ -475,16 +529,16 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
             {
                 cx.emits();
             }
-            for (id, what) in [
-                (
-                    "Subsurface Weight",
-                    "subsurface scattering renders as diffuse",
-                ),
-                ("Thin Film Thickness", "thin film is not rendered"),
-            ] {
-                if cx.is_linked(id) || cx.const_value(id).is_some_and(|v| v[0] != 0.0) {
-                    cx.warn(what);
-                }
+            let thin_film = "Thin Film Thickness";
+            if cx.is_linked(thin_film) || cx.const_value(thin_film).is_some_and(|v| v[0] != 0.0) {
+                cx.warn("thin film is not rendered");
+            }
+            let ss = "Subsurface Weight";
+            if !p.cycles {
+                // glTF materials have no subsurface.
+            } else if cx.is_linked(ss) || cx.const_value(ss).is_some_and(|v| v[0] != 0.0) {
+                cx.scatters_below();
+                warn_subsurface_method(cx, "subsurface_method");
             }
             ClosureParams::Principled(Box::new(p))
         }
@@ -529,6 +583,19 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
             ClosureParams::Sheen {
                 color: cx.color("Color", Vec3::splat(0.8))?,
                 roughness: cx.float("Roughness", 0.5)?,
+                normal: normal(cx, "Normal")?,
+            }
+        }
+        "ShaderNodeSubsurfaceScattering" => {
+            cx.scatters_below();
+            warn_subsurface_method(cx, "falloff");
+            ClosureParams::Subsurface {
+                color: cx.color("Color", Vec3::splat(0.8))?,
+                scale: cx.float("Scale", 0.05)?,
+                radius: cx.vector("Radius", Vec3::new(1.0, 0.2, 0.1))?,
+                ior: cx.float("IOR", 1.4)?,
+                roughness: cx.float("Roughness", 1.0)?,
+                anisotropy: cx.float("Anisotropy", 0.0)?,
                 normal: normal(cx, "Normal")?,
             }
         }
