@@ -379,24 +379,10 @@ mod tests {
             base_color: Vec3::splat(0.8),
             metallic,
             roughness,
-            ior: 1.5,
             specular_level: 0.5,
-            specular_tint: Vec3::ONE,
-            transmission: 0.0,
-            anisotropic: 0.0,
-            anisotropic_rotation: 0.0,
             coat_weight: 1.0,
             coat_roughness,
-            coat_ior: 1.5,
-            coat_tint: Vec3::ONE,
-            coat_normal: Vec3::ZERO,
-            sheen_weight: 0.0,
-            sheen_roughness: 0.5,
-            sheen_tint: Vec3::ONE,
-            subsurface_weight: 0.0,
-            subsurface_radius: Vec3::ONE,
-            subsurface_scale: 0.0,
-            cycles: true,
+            ..Principled::lobe_only()
         }))
     }
 
