@@ -631,7 +631,9 @@ def test_real_session_takes_every_edit(monkeypatch, tmp_path):
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
     scene = simple_scene(24, 16)
     scene.tesela.preview_samples = 2
-    scene.world = scene.world or bpy.data.worlds.new("World")
+    # A new world: one left by an earlier test may feed its Background's Color from a node
+    # (a sky), and then the edit below changes nothing.
+    scene.world = bpy.data.worlds.new("World")
     use_nodes(scene.world)
     background = next(n for n in scene.world.node_tree.nodes if n.type == "BACKGROUND")
     engine = StandInEngine()
