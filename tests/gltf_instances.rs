@@ -5,7 +5,7 @@
 use base64::Engine;
 use glam::{Mat4, Quat, Vec3};
 use serde_json::{Value, json};
-use tesela::scene::gltf::load_from_slice;
+use tesela::scene::gltf::{LoadOptions, load_from_slice, load_from_slice_with};
 use tesela::scene::{LoadErrorKind, Scene};
 
 fn f32s(v: &[f32]) -> Vec<u8> {
@@ -55,8 +55,11 @@ fn doc(nodes: Value, indices: &[u16], extra: &[(&str, Vec<f32>)]) -> Value {
     })
 }
 
+/// Loads with every mesh placed more than once instanced, however few triangles it has (by
+/// default small ones are baked: see `small_placements_are_baked`).
 fn load(d: &Value) -> Scene {
-    load_from_slice(&serde_json::to_vec(d).unwrap(), None, "t.gltf").unwrap()
+    let instanced = LoadOptions { bake_triangles: 0 };
+    load_from_slice_with(&serde_json::to_vec(d).unwrap(), None, "t.gltf", &instanced).unwrap()
 }
 
 fn err(d: &Value) -> (LoadErrorKind, String) {
@@ -72,6 +75,33 @@ fn err(d: &Value) -> (LoadErrorKind, String) {
 
 fn gpu(attributes: Value) -> Value {
     json!({ "EXT_mesh_gpu_instancing": { "attributes": attributes } })
+}
+
+#[test]
+fn small_placements_are_baked() {
+    // Three placements of a one-triangle mesh: baked by default (3 triangles in all),
+    // instanced once the copies would exceed the limit.
+    let d = doc(
+        json!([
+            { "mesh": 0, "translation": [1, 0, 0], "children": [1, 2] },
+            { "mesh": 0, "scale": [-1, 2, 1] },
+            { "mesh": 0, "translation": [0, 3, 0] }
+        ]),
+        &[0, 1, 2],
+        &[],
+    );
+    let bytes = serde_json::to_vec(&d).unwrap();
+    let baked = load_from_slice(&bytes, None, "t.gltf").unwrap();
+    assert_eq!((baked.meshes.len(), baked.instances.len()), (3, 0));
+    assert_eq!(baked.instanced_triangle_count(), 3);
+    for (limit, instances) in [(3, 0), (2, 3)] {
+        let o = LoadOptions {
+            bake_triangles: limit,
+        };
+        let s = load_from_slice_with(&bytes, None, "t.gltf", &o).unwrap();
+        assert_eq!(s.instances.len(), instances, "limit {limit}");
+        assert_eq!(s.instanced_triangle_count(), 3);
+    }
 }
 
 #[test]

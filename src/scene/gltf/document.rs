@@ -111,7 +111,13 @@ impl Document {
                 .in_file(&self.name));
             }
         }
-        load_parsed(raw, &root, &buffers, self.base_dir.as_deref())
-            .map_err(|e| e.in_file(&self.name))
+        load_parsed(
+            raw,
+            &root,
+            &buffers,
+            self.base_dir.as_deref(),
+            &super::LoadOptions::default(),
+        )
+        .map_err(|e| e.in_file(&self.name))
     }
 }

@@ -119,6 +119,14 @@ impl<'a> Loader<'a> {
             *placements.entry(geometry[&u.mesh]).or_default() += n;
             total = total.saturating_add(n);
         }
+        // Triangles of all the copies of each geometry, had they been baked.
+        let mut baked_size: HashMap<usize, usize> = HashMap::new();
+        for u in &uses {
+            let n = u.gpu.len().max(1);
+            let t = self.mesh_triangles(u.mesh).saturating_mul(n);
+            let e = baked_size.entry(geometry[&u.mesh]).or_default();
+            *e = e.saturating_add(t);
+        }
         if total > MAX_INSTANCES {
             return Err(LoadError::new(
                 LoadErrorKind::TooLarge,
@@ -133,7 +141,8 @@ impl<'a> Loader<'a> {
         for u in uses {
             let own_weights = self.root.nodes[u.node].weights.is_some();
             let g = geometry[&u.mesh];
-            if u.gpu.is_empty() && (placements[&g] == 1 || own_weights) {
+            let small = baked_size[&g] <= self.options.bake_triangles;
+            if u.gpu.is_empty() && (placements[&g] == 1 || own_weights || small) {
                 let (baked, _) = self.instance_mesh(u.node, u.mesh, u.world, false)?;
                 let origins = &mut self.origins.mesh_node;
                 origins.resize(baked.start, None);
@@ -221,6 +230,29 @@ impl<'a> Loader<'a> {
     /// extras) and whose materials read the same attributes are one geometry, stored once.
     /// This is how a file gives objects that share a mesh their own materials. Other meshes
     /// are each their own geometry.
+    /// Triangles of glTF mesh `mi` as its primitives' index (or vertex) counts give them.
+    fn mesh_triangles(&self, mi: usize) -> usize {
+        let Some(mesh) = self.root.meshes.get(mi) else {
+            return 0;
+        };
+        let count = |a: usize| self.root.accessors.get(a).map_or(0, |a| a.count.0 as usize);
+        mesh.primitives
+            .iter()
+            .map(|p| {
+                let n = match &p.indices {
+                    Some(i) => count(i.value()),
+                    None => p
+                        .attributes
+                        .get(&json::validation::Checked::Valid(
+                            json::mesh::Semantic::Positions,
+                        ))
+                        .map_or(0, |a| count(a.value())),
+                };
+                n / 3
+            })
+            .fold(0usize, usize::saturating_add)
+    }
+
     pub(crate) fn geometries(
         &mut self,
         meshes: &[usize],

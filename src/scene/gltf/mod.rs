@@ -109,6 +109,24 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
     load_from_slice(&bytes, Some(base), &name)
 }
 
+/// How a load turns the file into a scene.
+#[derive(Clone, Copy, Debug)]
+pub struct LoadOptions {
+    /// A mesh placed several times is still baked into world space while all its copies
+    /// together have at most this many triangles: one flat BVH traces faster than instances
+    /// (a two-level traversal transforms every ray), and so few copies cost little memory.
+    /// 0: every mesh placed more than once is instanced.
+    pub bake_triangles: usize,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        LoadOptions {
+            bake_triangles: 1 << 18,
+        }
+    }
+}
+
 /// Loads glTF JSON or GLB bytes. `base_dir` is the folder external URIs are resolved in
 /// (`None` refuses every external file); `name` names the input in messages.
 pub fn load_from_slice(
@@ -116,20 +134,34 @@ pub fn load_from_slice(
     base_dir: Option<&Path>,
     name: &str,
 ) -> Result<Scene, LoadError> {
-    load_inner(bytes, base_dir).map_err(|e| e.in_file(name))
+    load_from_slice_with(bytes, base_dir, name, &LoadOptions::default())
+}
+
+/// [`load_from_slice`] with explicit [`LoadOptions`].
+pub fn load_from_slice_with(
+    bytes: &[u8],
+    base_dir: Option<&Path>,
+    name: &str,
+    options: &LoadOptions,
+) -> Result<Scene, LoadError> {
+    load_inner(bytes, base_dir, options).map_err(|e| e.in_file(name))
 }
 
 fn invalid(msg: String) -> LoadError {
     LoadError::new(LoadErrorKind::Invalid, msg)
 }
 
-fn load_inner(bytes: &[u8], base_dir: Option<&Path>) -> Result<Scene, LoadError> {
+fn load_inner(
+    bytes: &[u8],
+    base_dir: Option<&Path>,
+    options: &LoadOptions,
+) -> Result<Scene, LoadError> {
     let c = container::split(bytes)?;
     let raw = parse_json(c.json)?;
     let root = typed_document(&raw)?;
     let buffers = resolve_buffers(&root, c.bin, base_dir)?;
     let buffer_refs: Vec<&[u8]> = buffers.iter().map(|b| &b[..]).collect();
-    load_parsed(&raw, &root, &buffer_refs, base_dir).map(|(scene, _)| scene)
+    load_parsed(&raw, &root, &buffer_refs, base_dir, options).map(|(scene, _)| scene)
 }
 
 /// The document's JSON, which must be an object.
@@ -151,6 +183,7 @@ fn load_parsed(
     root: &json::Root,
     buffers: &[&[u8]],
     base_dir: Option<&Path>,
+    options: &LoadOptions,
 ) -> Result<(Scene, Origins), LoadError> {
     let version = root.asset.version.trim();
     if !version.starts_with("2.") && version != "2" {
@@ -196,6 +229,7 @@ fn load_parsed(
         tri_total: 0,
         vert_total: 0,
         origins: Origins::default(),
+        options: *options,
     };
     loader.root_extensions()?;
     loader.walk()?;
@@ -407,6 +441,7 @@ pub(crate) struct Loader<'a> {
     pub vert_total: usize,
     /// Which node made each mesh, instance and light.
     pub origins: Origins,
+    pub options: LoadOptions,
 }
 
 /// `raw[key]` as an object member, if present.

@@ -119,7 +119,12 @@ fn instancing_trs_and_nested_matrices() {
     ])))
     .unwrap();
     doc["scenes"][0]["nodes"] = json!([0, 1]);
-    let s = load(&serde_json::to_vec(&doc).unwrap());
+    let bytes = serde_json::to_vec(&doc).unwrap();
+    // By default two copies of a triangle are baked (a flat BVH is faster); instanced:
+    let baked = load(&bytes);
+    assert_eq!((baked.meshes.len(), baked.instances.len()), (2, 0));
+    let instanced = super::LoadOptions { bake_triangles: 0 };
+    let s = super::load_from_slice_with(&bytes, None, "test.gltf", &instanced).unwrap();
     assert_eq!(s.meshes.len(), 1, "one mesh stored once");
     assert_eq!(s.instances.len(), 2, "and placed twice");
     assert!(
