@@ -21,6 +21,12 @@ pub struct ClassWeights {
 }
 
 impl ClassWeights {
+    /// All diffuse (Cycles counts light through a subsurface walk as diffuse).
+    pub const DIFFUSE: ClassWeights = ClassWeights {
+        diffuse: Vec3::ONE,
+        glossy: Vec3::ZERO,
+    };
+
     /// The weights of light scattered from local direction `rec.wo` to `rec.wi` by `bsdf`:
     /// its [`Bsdf::eval_split`] over its value, per channel (0 where the value is 0). A
     /// direction sampled from a delta lobe is glossy when it reflects, transmission when it
@@ -186,23 +192,11 @@ mod tests {
             roughness: 0.4,
             ior: 1.45,
             specular_level: 0.5,
-            specular_tint: Vec3::ONE,
             transmission,
-            anisotropic: 0.0,
-            anisotropic_rotation: 0.0,
             coat_weight: coat,
             coat_roughness: 0.2,
-            coat_ior: 1.5,
-            coat_tint: Vec3::ONE,
-            coat_normal: Vec3::ZERO,
             sheen_weight: sheen,
-            sheen_roughness: 0.5,
-            sheen_tint: Vec3::ONE,
-            subsurface_weight: 0.0,
-            subsurface_radius: Vec3::ONE,
-            subsurface_scale: 0.0,
-            subsurface_anisotropy: 0.0,
-            cycles: true,
+            ..Principled::lobe_only()
         }
     }
 

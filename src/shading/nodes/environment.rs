@@ -98,25 +98,29 @@ impl EnvironmentOp {
     }
 }
 
+/// The node's Vector input; unlinked, the shading point's position, which for the world is
+/// the view direction.
+pub(super) fn direction_input(cx: &mut NodeCx) -> Result<Slot, CompileError> {
+    if cx.is_linked("Vector") {
+        return cx.vector("Vector", Vec3::ZERO);
+    }
+    let out = cx.alloc(3)?;
+    cx.emit(
+        Op::Input(InputOp {
+            src: Source::Position,
+            out,
+        }),
+        true,
+    );
+    Ok(out)
+}
+
 /// Compiles the Environment Texture; `Ok(false)` for other kinds.
 pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
     if kind != "ShaderNodeTexEnvironment" {
         return Ok(false);
     }
-    let vector = if cx.is_linked("Vector") {
-        cx.vector("Vector", Vec3::ZERO)?
-    } else {
-        // Unlinked: the shading point's position, which for the world is the view direction.
-        let out = cx.alloc(3)?;
-        cx.emit(
-            Op::Input(InputOp {
-                src: Source::Position,
-                out,
-            }),
-            true,
-        );
-        out
-    };
+    let vector = direction_input(cx)?;
     let color = cx.output("Color", SocketType::Color)?;
     let alpha = cx.output("Alpha", SocketType::Float)?;
     let Some(image) = cx.node().image else {

@@ -7,7 +7,6 @@
 //! Directions are Blender world space (Z up). The sun sits at elevation `e` and Cycles'
 //! rotation `r` (after [`sun_position`]) in direction `(-cos e sin r, cos e cos r, sin e)`.
 
-use super::input::{InputOp, Source};
 use crate::shading::compile::{CompileError, NodeCx, SocketType};
 use crate::shading::globals::{ShaderGlobals, ray};
 use crate::shading::graph::{Graph, Input, Node};
@@ -425,20 +424,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
     if cx.prop("texture_mapping").is_some_and(|v| !v.is_null()) {
         cx.warn("the node's texture mapping is ignored");
     }
-    let vector = if cx.is_linked("Vector") {
-        cx.vector("Vector", Vec3::ZERO)?
-    } else {
-        // Unlinked: the shading point's position, which for the world is the view direction.
-        let out = cx.alloc(3)?;
-        cx.emit(
-            Op::Input(InputOp {
-                src: Source::Position,
-                out,
-            }),
-            true,
-        );
-        out
-    };
+    let vector = super::environment::direction_input(cx)?;
     let color = cx.output("Color", SocketType::Color)?;
     let op = match params {
         Some(p) => SkyOp::Table(TableSky::new(&p, vector, color)),

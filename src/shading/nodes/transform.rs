@@ -4,6 +4,7 @@
 //! `svm_node_camera` and `svm_node_tangent` compute them. Vectors are in Blender's world
 //! axes (Z up) unless a node converts them.
 
+use super::bump::safe_normalize;
 use super::vector::euler_xyz;
 use crate::shading::compile::{CompileError, NodeCx, SocketType};
 use crate::shading::globals::{ShadeEnv, ShaderGlobals, from_blender};
@@ -113,15 +114,6 @@ pub fn vector_rotate(
     rotate_around_axis(v - c, axis / len, angle) + c
 }
 
-fn normalize_or_zero(v: Vec3) -> Vec3 {
-    let l = v.length();
-    if l > 0.0 && l.is_finite() {
-        v / l
-    } else {
-        Vec3::ZERO
-    }
-}
-
 /// An affine map of Blender-world vectors and how it moves each kind of vector.
 struct Affine(Mat4);
 
@@ -131,9 +123,7 @@ impl Affine {
             VectorKind::Point => self.0.transform_point3(v),
             VectorKind::Vector => self.0.transform_vector3(v),
             // Normals go through the inverse transpose of the map that moves points.
-            VectorKind::Normal => {
-                normalize_or_zero(Mat3::from_mat4(self.0).inverse().transpose() * v)
-            }
+            VectorKind::Normal => safe_normalize(Mat3::from_mat4(self.0).inverse().transpose() * v),
         }
     }
 }
@@ -227,7 +217,7 @@ impl TransformOp {
                 out_dot,
             } => {
                 s.set_v(out_normal, direction);
-                s.set_f(out_dot, direction.dot(normalize_or_zero(s.v(normal))));
+                s.set_f(out_dot, direction.dot(safe_normalize(s.v(normal))));
             }
             TransformOp::Camera {
                 view_vector,
@@ -235,7 +225,7 @@ impl TransformOp {
                 distance,
             } => {
                 let c = world_to_camera(env).apply(VectorKind::Point, g.p);
-                s.set_v(view_vector, normalize_or_zero(c));
+                s.set_v(view_vector, safe_normalize(c));
                 s.set_f(z_depth, c.z);
                 s.set_f(distance, c.length());
             }
@@ -257,13 +247,13 @@ impl TransformOp {
                         };
                         // Object → world as a normal (Cycles' object_normal_transform).
                         match world_to_object(g) {
-                            Some(m) => normalize_or_zero(Mat3::from_mat4(m.0).transpose() * t),
+                            Some(m) => safe_normalize(Mat3::from_mat4(m.0).transpose() * t),
                             None => t,
                         }
                     }
                 };
                 // Orthogonal to the shading normal, in the plane of the normal and `t`.
-                s.set_v(out, g.n.cross(normalize_or_zero(t.cross(g.n))));
+                s.set_v(out, g.n.cross(safe_normalize(t.cross(g.n))));
             }
         }
     }
@@ -340,7 +330,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
                     d = Vec3::new(c[0], c[1], c[2]);
                 }
             }
-            let direction = normalize_or_zero(d);
+            let direction = safe_normalize(d);
             let normal = cx.vector("Normal", Vec3::Z)?;
             let out_normal = cx.output("Normal", Vector)?;
             let out_dot = cx.output("Dot", Float)?;

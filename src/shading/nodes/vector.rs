@@ -1,6 +1,7 @@
 //! Vector nodes: Mapping and Normal Map, and the glTF preset's texture transform, normal map
 //! (with glTF's `scale`) and anisotropy direction.
 
+use super::bump::safe_normalize;
 use crate::shading::compile::{CompileError, NodeCx, SocketType};
 use crate::shading::globals::{ShaderGlobals, to_blender};
 use crate::shading::program::{Op, Slot, Slots};
@@ -62,15 +63,6 @@ pub fn euler_xyz(r: Vec3) -> Mat3 {
 /// `a / b` per component, 0 where `b` is 0 (Cycles' `safe_divide`).
 fn safe_divide(a: Vec3, b: Vec3) -> Vec3 {
     Vec3::select(b.cmpeq(Vec3::ZERO), Vec3::ZERO, a / b)
-}
-
-fn safe_normalize(v: Vec3) -> Vec3 {
-    let l = v.length();
-    if l > 0.0 && l.is_finite() {
-        v / l
-    } else {
-        Vec3::ZERO
-    }
 }
 
 /// Blender's Mapping node.
