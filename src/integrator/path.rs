@@ -135,20 +135,16 @@ impl PathMats {
             let (its, sp, dv) = match sp.subsurface {
                 None => (&its, &sp, d),
                 Some(b) => {
-                    let Some((exit, dv)) =
-                        subsurface::scatter(scene, ctx, &its, d, &sp, &b, &mut throughput)
+                    let Some(v) =
+                        subsurface::exit_vertex(scene, ctx, &its, d, &sp, &b, &mut throughput)
                     else {
                         return l;
                     };
                     if S::ACTIVE && depth == 1 {
-                        // Cycles counts light through a walk as diffuse.
-                        weights = ClassWeights {
-                            diffuse: Vec3::ONE,
-                            glossy: Vec3::ZERO,
-                        };
+                        weights = ClassWeights::DIFFUSE;
                     }
-                    walked = (exit, ShadingPoint::subsurface_exit(&exit, dv));
-                    (&walked.0, &walked.1, dv)
+                    walked = v;
+                    (&walked.0, &walked.1, walked.2)
                 }
             };
             let Some((wo, w, rec)) = sp.sample(ctx, its, dv) else {
@@ -262,20 +258,16 @@ impl PathMis {
             let (its, sp, dv) = match sp.subsurface {
                 None => (&its, &sp, d),
                 Some(b) => {
-                    let Some((exit, dv)) =
-                        subsurface::scatter(scene, ctx, &its, d, &sp, &b, &mut throughput)
+                    let Some(v) =
+                        subsurface::exit_vertex(scene, ctx, &its, d, &sp, &b, &mut throughput)
                     else {
                         return l;
                     };
                     if S::ACTIVE && depth == 1 {
-                        // Cycles counts light through a walk as diffuse.
-                        weights = ClassWeights {
-                            diffuse: Vec3::ONE,
-                            glossy: Vec3::ZERO,
-                        };
+                        weights = ClassWeights::DIFFUSE;
                     }
-                    walked = (exit, ShadingPoint::subsurface_exit(&exit, dv));
-                    (&walked.0, &walked.1, dv)
+                    walked = v;
+                    (&walked.0, &walked.1, walked.2)
                 }
             };
             if !sp.bsdf_is_delta() {

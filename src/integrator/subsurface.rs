@@ -386,6 +386,21 @@ pub fn entry_direction(b: &Bssrdf, n: Vec3, wi: Vec3, u: Vec2) -> Option<Vec3> {
     Some((-eta * wi + (eta * cos_hi - root) * h).normalize())
 }
 
+/// [`scatter`], then the vertex the path goes on from: the exit point, its white diffuse
+/// shading point, and the direction it is seen along from outside.
+pub fn exit_vertex(
+    scene: &RenderScene,
+    ctx: &mut Ctx,
+    its: &Intersection,
+    d: Vec3,
+    sp: &ShadingPoint,
+    b: &Bssrdf,
+    throughput: &mut Vec3,
+) -> Option<(Intersection, ShadingPoint, Vec3)> {
+    let (exit, dv) = scatter(scene, ctx, its, d, sp, b, throughput)?;
+    Some((exit, ShadingPoint::subsurface_exit(&exit, dv), dv))
+}
+
 /// Scatters a path that chose the subsurface closure at `its` (seen along the unit `d`,
 /// shading point `sp` whose frame normal is the BSSRDF's): samples the entry, walks inside
 /// the object that was hit (its mesh and instance only) and returns the exit point and a
