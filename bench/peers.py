@@ -555,6 +555,9 @@ def merge(args):
 # scenes through the Blender add-on (--addon): Blender node materials and worlds, as users have them
 
 ADDON_SCENES = {
+    # The Blender-built Cornell box (tests/blender/scenes.py): Principled walls, an emissive
+    # ceiling quad.
+    "cornell": ("scenes", "cornell_box"),
     # A rough Principled floor with a tangent-space Normal Map from an image, lit by a low sun
     # and a dim world (tests/blender/test_material_scenes_cycles.py: normal_map).
     "normalmap": ("test_material_scenes_cycles", "normal_map"),

@@ -451,6 +451,27 @@ pub fn record_rays(
     Ok(ctx.log.unwrap_or_default())
 }
 
+/// What the workers on one row of a tile did in a round.
+#[derive(Default)]
+struct RowWork {
+    rays: u64,
+    rejected: u64,
+    /// Some pixel rendered samples.
+    worked: bool,
+    cancelled: bool,
+}
+
+impl RowWork {
+    fn merge(a: RowWork, b: RowWork) -> RowWork {
+        RowWork {
+            rays: a.rays + b.rays,
+            rejected: a.rejected + b.rejected,
+            worked: a.worked || b.worked,
+            cancelled: a.cancelled || b.cancelled,
+        }
+    }
+}
+
 /// One tile's pixels and their sums, owned by whichever worker renders it in a round.
 struct TileState {
     x: u32,
@@ -669,45 +690,58 @@ impl Progressive {
             passes: &self.acc_passes,
             mist: scene.scene.settings.mist,
         });
+        // Rows are the unit of work, tiles the unit of streaming: late adaptive rounds leave
+        // the unconverged pixels in a few tiles, which whole-tile work would give one thread.
         let result: Result<(), RenderError> = pool.install(|| {
             self.tiles.par_iter_mut().try_for_each(|t| {
-                let mut ctx = Ctx::new(SobolSampler::new(0, 0, 0));
-                let mut rej = 0u64;
-                let mut worked = false;
-                for y in 0..t.h {
-                    for x in 0..t.w {
-                        let i = (y * t.w + x) as usize;
-                        let acc = &mut t.px[i];
+                let (tx, ty, tw) = (t.x, t.y, t.w as usize);
+                let mut aov_rows = t.aov.chunks_mut((tw * acc_stride).max(1));
+                let rows: Vec<(&mut [PixelAcc], &mut [f32])> = (t.px.chunks_mut(tw))
+                    .map(|px| (px, aov_rows.next().unwrap_or(&mut [])))
+                    .collect();
+                let row = |(y, (px, aov)): (usize, (&mut [PixelAcc], &mut [f32]))| {
+                    let mut ctx = Ctx::new(SobolSampler::new(0, 0, 0));
+                    let mut w = RowWork::default();
+                    for (x, acc) in px.iter_mut().enumerate() {
                         if acc.converged || acc.next >= end {
                             continue;
                         }
                         // Polled per pixel: a pixel's samples are the longest wait (a row of
                         // a tile at 16 samples in a million-triangle scene is ~20 ms).
                         if cancel.load(Ordering::Relaxed) {
-                            t.rays += ctx.rays;
-                            t.rejected += rej;
-                            return Err(RenderError::Cancelled);
+                            w.cancelled = true;
+                            break;
                         }
-                        worked = true;
+                        w.worked = true;
                         render_samples(
                             scene,
                             camera,
                             integrator.as_ref(),
                             opts,
                             data_ctx.as_ref(),
-                            (rx + t.x + x, ry + t.y + y),
+                            (rx + tx + x as u32, ry + ty + y as u32),
                             end,
                             &mut ctx,
-                            &mut rej,
+                            &mut w.rejected,
                             acc,
-                            &mut t.aov[i * acc_stride..(i + 1) * acc_stride],
+                            &mut aov[x * acc_stride..(x + 1) * acc_stride],
                             sampling,
                         );
                     }
+                    w.rays = ctx.rays;
+                    w
+                };
+                let w = rows
+                    .into_par_iter()
+                    .enumerate()
+                    .map(row)
+                    .reduce(RowWork::default, RowWork::merge);
+                t.rays += w.rays;
+                t.rejected += w.rejected;
+                if w.cancelled {
+                    return Err(RenderError::Cancelled);
                 }
-                t.rays += ctx.rays;
-                t.rejected += rej;
-                after(t, worked);
+                after(t, w.worked);
                 Ok(())
             })
         });
