@@ -668,7 +668,7 @@ mod tests {
             let o = Vec3::new(rnd(), rnd(), rnd()) * 6.0;
             let mut d = Vec3::new(rnd(), rnd(), rnd());
             if i % 7 == 0 {
-                d = d * Vec3::new(1.0, 0.0, (i % 2) as f32); // axis-parallel, zero components
+                d *= Vec3::new(1.0, 0.0, (i % 2) as f32); // axis-parallel, zero components
             }
             let Some(d) = d.try_normalize() else { continue };
             let tmax = if i % 3 == 0 {

@@ -112,6 +112,47 @@ pub struct RayQuery {
     pub kind: RayKind,
 }
 
+/// A hash of a hit point's coordinates: the seed of the rays its shading program casts.
+#[inline]
+fn point_seed(p: Vec3) -> u32 {
+    let h =
+        (p.x.to_bits() as u64) ^ ((p.y.to_bits() as u64) << 21) ^ ((p.z.to_bits() as u64) << 42);
+    let h = (h ^ (h >> 31)).wrapping_mul(0x7fb5_d329_728e_a185);
+    (h ^ (h >> 27)).wrapping_mul(0x81da_def4_bc2d_d44d) as u32 ^ (h >> 33) as u32
+}
+
+impl crate::shading::globals::Occluder for RenderScene {
+    fn blocked(&self, g: &ShaderGlobals, d: Vec3, tmax: f32, only_local: bool) -> bool {
+        use crate::shading::globals::from_blender;
+        let d = from_blender(d);
+        let o = offset_origin(from_blender(g.p), from_blender(g.ng), d);
+        let (mut trav, mut top) = (Traversal::default(), Traversal::default());
+        if !only_local {
+            return self.accel.occluded_with(&mut trav, o, d, 0.0, tmax)
+                || (self.instances.as_ref())
+                    .is_some_and(|i| i.occluded_with(&mut top, &mut trav, o, d, 0.0, tmax));
+        }
+        let mut tmin = 0.0;
+        for _ in 0..MAX_LOCAL_SKIPS {
+            let hit = self.accel.intersect_with(&mut trav, o, d, tmin, tmax);
+            let hit = match &self.instances {
+                None => hit,
+                Some(inst) => {
+                    let t = hit.map_or(tmax, |h| h.t);
+                    inst.intersect_with(&mut top, &mut trav, o, d, tmin, t)
+                        .or(hit)
+                }
+            };
+            let Some(hit) = hit else { return false };
+            if [hit.key[0], hit.instance] == g.object {
+                return true;
+            }
+            tmin = hit.t;
+        }
+        false
+    }
+}
+
 /// Per-path-sample state: the random stream and counters.
 pub struct Ctx {
     pub sampler: crate::sampler::SobolSampler,
@@ -996,6 +1037,7 @@ impl RenderScene {
             images: &self.scene.images,
             textures: &self.scene.textures,
             camera_to_world: self.camera_to_world,
+            occluder: Some(self),
         }
     }
 
@@ -1032,6 +1074,8 @@ impl RenderScene {
             ray_depth: depth,
             ray_length: its.t,
             ray_flags: flags,
+            object: [its.mesh, its.instance],
+            seed: point_seed(its.p),
         }
     }
 

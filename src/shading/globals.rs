@@ -34,6 +34,14 @@ pub mod ray {
     pub const IMPORTANCE_BAKE: u32 = 128;
 }
 
+/// Rays a program may cast (the Ambient Occlusion node): the scene's geometry.
+pub trait Occluder: Sync {
+    /// Whether a surface lies on the segment from shading point `g` (moved off its surface)
+    /// along the unit direction `d` (Blender world space) up to distance `tmax`; with
+    /// `only_local`, only the surfaces of `g`'s own object count.
+    fn blocked(&self, g: &ShaderGlobals, d: Vec3, tmax: f32, only_local: bool) -> bool;
+}
+
 /// Scene data a program may look up.
 #[derive(Clone, Copy)]
 pub struct ShadeEnv<'a> {
@@ -41,6 +49,9 @@ pub struct ShadeEnv<'a> {
     pub textures: &'a [Texture],
     /// Camera to world, Blender coordinates (the camera looks down its local -Z).
     pub camera_to_world: Mat4,
+    /// The scene's geometry for the rays a program casts; `None` where there is none to
+    /// trace (emitters' set-up, tests): such rays see nothing.
+    pub occluder: Option<&'a dyn Occluder>,
 }
 
 /// A shading point. Vectors in Blender's world space unless said otherwise.
@@ -74,6 +85,11 @@ pub struct ShaderGlobals<'a> {
     /// Distance from the ray's origin to the point (Light Path's Ray Length; 0 without a ray).
     pub ray_length: f32,
     pub ray_flags: u32,
+    /// `[mesh, instance]` of the point's object (scene indices; `u32::MAX` for none).
+    pub object: [u32; 2],
+    /// Scrambles the random numbers of the rays the program casts at this point; kept by the
+    /// Bump node's offset points so their rays agree.
+    pub seed: u32,
 }
 
 impl<'a> ShaderGlobals<'a> {
@@ -97,6 +113,8 @@ impl<'a> ShaderGlobals<'a> {
             ray_depth: 1,
             ray_length: 0.0,
             ray_flags: ray::CAMERA,
+            object: [u32::MAX; 2],
+            seed: 0,
         }
     }
 

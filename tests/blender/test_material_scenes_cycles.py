@@ -550,6 +550,36 @@ def wireframe_ball():
     _sphere_stage(mat)
 
 
+def ambient_occlusion(inside_local=False):
+    """The Ambient Occlusion node. Floor: its Color output (a warm grey times the open
+    fraction within 0.8 m) as a Diffuse colour, so the floor darkens towards the ball and a
+    box beside it. Inside + Only Local: the ball's colour is the fraction of inward rays that
+    leave the ball within 0.5 m (analytically cos^2 = (0.5 / 1.2)^2, 0.17, everywhere)."""
+    def build():
+        if inside_local:
+            mat, nt, out = node_material("AOInside")
+            ao = node(nt, "ShaderNodeAmbientOcclusion",
+                      {"samples": 8, "inside": True, "only_local": True}, Distance=0.5)
+            dif = node(nt, "ShaderNodeBsdfDiffuse", Color=ao.outputs["AO"])
+            surface(nt, out, dif.outputs[0])
+            _sphere_stage(mat)
+            return
+        fmat, fnt, fout = node_material("DirtFloor")
+        ao = node(fnt, "ShaderNodeAmbientOcclusion", {"samples": 16},
+                  Color=(0.8, 0.75, 0.7, 1.0), Distance=0.8)
+        dif = node(fnt, "ShaderNodeBsdfDiffuse", Color=ao.outputs["Color"])
+        surface(fnt, fout, dif.outputs[0])
+        scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)], fmat)
+        scenes.add_sphere("Ball", (0.0, 0.0, 0.6), 0.6, lambert_mat("Ball", (0.6, 0.6, 0.6)),
+                          segments=64, rings=32)
+        scenes.add_box("Crate", (0.8, -0.2, 0.0), (1.3, 0.4, 0.5),
+                       lambert_mat("Crate", (0.5, 0.4, 0.3)))
+        scenes.add_sun_light("Sun", (-0.5, 0.6, -0.8), 3.0)
+        world(0.6)
+        scenes.add_camera((0.0, -2.6, 1.5), (0.0, 0.0, 0.55), fov=math.radians(40.0))
+    return build
+
+
 def sheen_bsdf():
     """The Sheen BSDF added to a dark Diffuse: the fabric look."""
     mat, nt, out = node_material("Velvet")
@@ -630,6 +660,8 @@ CASES = [
     ("principled_coat", principled_variant("coat"), 0, 256, 1024),
     ("principled_sheen", principled_variant("sheen"), 0, 256, 1024),
     ("wireframe_ball", wireframe_ball, 0, 128, 512),
+    ("ambient_occlusion_floor", ambient_occlusion(), 2, 128, 512),
+    ("ambient_occlusion_inside_local", ambient_occlusion(True), 0, 128, 512),
     ("metallic_bsdf_f82_anisotropic", metallic_bsdf("F82"), 0, 256, 1024),
     ("metallic_bsdf_physical_conductor", metallic_bsdf("PHYSICAL_CONDUCTOR"), 0, 256, 1024),
     pytest.param(("sheen_bsdf_over_diffuse", sheen_bsdf, 0, 256, 1024),

@@ -1,5 +1,6 @@
 //! Node families: each file compiles its nodes into operations and evaluates them.
 
+pub mod ao;
 pub mod bsdf;
 pub mod bump;
 pub mod color;
@@ -33,6 +34,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         vector::compile,
         transform::compile,
         wireframe::compile,
+        ao::compile,
         bump::compile,
         displacement::compile,
         convert::compile,
