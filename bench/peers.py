@@ -722,7 +722,7 @@ def clean_bench(args):
         if hasattr(c, "denoising_input_passes"):
             c.denoising_input_passes = "RGB_ALBEDO_NORMAL"
         runs = [("cycles", "CYCLES", "defaults: threshold 0.01, OIDN, 4096 max", 4096, None)]
-        for thr in (0.01, 0.02, 0.05):
+        for thr in (0.01, 0.0125, 0.015, 0.02, 0.05):
             runs.append(("tesela", "TESELA", f"threshold {thr}, OIDN, 1024 max", 1024, thr))
         for peer, engine, label, spp, thr in runs:
             if thr is not None:

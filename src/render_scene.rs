@@ -121,7 +121,7 @@ fn point_seed(p: Vec3) -> u32 {
     (h ^ (h >> 27)).wrapping_mul(0x81da_def4_bc2d_d44d) as u32 ^ (h >> 33) as u32
 }
 
-impl crate::shading::globals::Occluder for RenderScene {
+impl crate::shading::globals::Tracer for RenderScene {
     fn blocked(&self, g: &ShaderGlobals, d: Vec3, tmax: f32, only_local: bool) -> bool {
         use crate::shading::globals::from_blender;
         let d = from_blender(d);
@@ -150,6 +150,47 @@ impl crate::shading::globals::Occluder for RenderScene {
             tmin = hit.t;
         }
         false
+    }
+
+    fn local_hits(
+        &self,
+        g: &ShaderGlobals,
+        o: Vec3,
+        d: Vec3,
+        tmax: f32,
+        hits: &mut [crate::shading::globals::LocalHit],
+    ) -> usize {
+        use crate::shading::globals::{LocalHit, from_blender};
+        let (o, d) = (from_blender(o), from_blender(d));
+        let (mut trav, mut top) = (Traversal::default(), Traversal::default());
+        let (mut tmin, mut n) = (0.0, 0);
+        // Other objects' surfaces count towards the steps too: a bounded loop.
+        for _ in 0..(hits.len() as u32 + MAX_LOCAL_SKIPS) {
+            if n == hits.len() {
+                break;
+            }
+            let hit = self.accel.intersect_with(&mut trav, o, d, tmin, tmax);
+            let hit = match &self.instances {
+                None => hit,
+                Some(inst) => {
+                    let t = hit.map_or(tmax, |h| h.t);
+                    inst.intersect_with(&mut top, &mut trav, o, d, tmin, t)
+                        .or(hit)
+                }
+            };
+            let Some(hit) = hit else { break };
+            tmin = hit.t;
+            if [hit.key[0], hit.instance] == g.object {
+                let its = self.intersection(&hit, d);
+                hits[n] = LocalHit {
+                    p: to_blender(its.p),
+                    n: to_blender(its.ns),
+                    ng: to_blender(its.ng),
+                };
+                n += 1;
+            }
+        }
+        n
     }
 }
 
@@ -1037,7 +1078,7 @@ impl RenderScene {
             images: &self.scene.images,
             textures: &self.scene.textures,
             camera_to_world: self.camera_to_world,
-            occluder: Some(self),
+            tracer: Some(self),
         }
     }
 

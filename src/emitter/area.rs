@@ -80,7 +80,7 @@ impl AreaEmitter {
             images: &scene.images,
             textures: &scene.textures,
             camera_to_world: Mat4::IDENTITY,
-            occluder: None,
+            tracer: None,
         };
         for i in (0..varying).step_by(step) {
             let third = 1.0 / 3.0;
@@ -121,7 +121,7 @@ impl AreaEmitter {
             images: &scene.images,
             textures: &scene.textures,
             camera_to_world: self.camera_to_world,
-            occluder: None,
+            tracer: None,
         };
         let m = &scene.meshes[self.mesh];
         radiance(&self.program, m, rec.tri, rec.bary, Some(rec), &env)
@@ -241,7 +241,7 @@ const ENV0: ShadeEnv<'static> = ShadeEnv {
     images: &[],
     textures: &[],
     camera_to_world: Mat4::IDENTITY,
-    occluder: None,
+    tracer: None,
 };
 
 impl Emitter for AreaEmitter {

@@ -403,7 +403,7 @@ impl Environment {
             images: &scene.images,
             textures: &scene.textures,
             camera_to_world: self.camera_to_world,
-            occluder: None,
+            tracer: None,
         }
     }
 

@@ -126,7 +126,7 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
             images: &[],
             textures: &[],
             camera_to_world: glam::Mat4::IDENTITY,
-            occluder: None,
+            tracer: None,
         };
         let mut scratch = super::program::Scratch::default();
         program.run(&globals, &env, &mut scratch);

@@ -34,12 +34,34 @@ pub mod ray {
     pub const IMPORTANCE_BAKE: u32 = 128;
 }
 
-/// Rays a program may cast (the Ambient Occlusion node): the scene's geometry.
-pub trait Occluder: Sync {
+/// A surface of one object met by a local ray ([`Tracer::local_hits`]), Blender world space.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LocalHit {
+    pub p: Vec3,
+    /// Unit shading normal as interpolated (not turned towards the ray).
+    pub n: Vec3,
+    /// Unit geometric normal.
+    pub ng: Vec3,
+}
+
+/// Rays a program may cast (the Ambient Occlusion and Bevel nodes): the scene's geometry.
+pub trait Tracer: Sync {
     /// Whether a surface lies on the segment from shading point `g` (moved off its surface)
     /// along the unit direction `d` (Blender world space) up to distance `tmax`; with
     /// `only_local`, only the surfaces of `g`'s own object count.
     fn blocked(&self, g: &ShaderGlobals, d: Vec3, tmax: f32, only_local: bool) -> bool;
+
+    /// The surfaces of `g`'s object on the segment from `o` along the unit direction `d` up
+    /// to `tmax` (Blender world space), nearest first, as many as `hits` holds; returns how
+    /// many were written.
+    fn local_hits(
+        &self,
+        g: &ShaderGlobals,
+        o: Vec3,
+        d: Vec3,
+        tmax: f32,
+        hits: &mut [LocalHit],
+    ) -> usize;
 }
 
 /// Scene data a program may look up.
@@ -51,7 +73,7 @@ pub struct ShadeEnv<'a> {
     pub camera_to_world: Mat4,
     /// The scene's geometry for the rays a program casts; `None` where there is none to
     /// trace (emitters' set-up, tests): such rays see nothing.
-    pub occluder: Option<&'a dyn Occluder>,
+    pub tracer: Option<&'a dyn Tracer>,
 }
 
 /// A shading point. Vectors in Blender's world space unless said otherwise.

@@ -57,7 +57,7 @@ mod tests {
             images: &[],
             textures: &[],
             camera_to_world: glam::Mat4::IDENTITY,
-            occluder: None,
+            tracer: None,
         }
     }
 

@@ -84,7 +84,7 @@ fn shade(s: &Scene, mi: usize) -> ClosureSet {
         images: &s.images,
         textures: &s.textures,
         camera_to_world: Mat4::IDENTITY,
-        occluder: None,
+        tracer: None,
     };
     let mut scratch = Scratch::default();
     c.program.eval(&g, &env, &mut scratch).clone()

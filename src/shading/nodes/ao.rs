@@ -39,7 +39,7 @@ pub fn ambient_occlusion(
     samples: u32,
     only_local: bool,
 ) -> f32 {
-    let Some(occluder) = env.occluder else {
+    let Some(tracer) = env.tracer else {
         return 1.0;
     };
     if distance.is_nan() || distance <= 0.0 || samples == 0 || g.object[0] == u32::MAX {
@@ -52,7 +52,7 @@ pub fn ambient_occlusion(
         let d = square_to_uniform_disk(rng.next_2d());
         let z = (1.0 - d.length_squared()).max(0.0).sqrt();
         let w = frame.to_world(Vec3::new(d.x, d.y, z));
-        if !occluder.blocked(g, w, distance, only_local) {
+        if !tracer.blocked(g, w, distance, only_local) {
             open += 1;
         }
     }
@@ -106,7 +106,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shading::globals::Occluder;
+    use crate::shading::globals::Tracer;
     use glam::Vec2;
 
     /// Blocks every ray closer than `cos_max` to the normal +Z (a cone of surfaces overhead),
@@ -115,9 +115,20 @@ mod tests {
         cos_max: f32,
     }
 
-    impl Occluder for Cone {
+    impl Tracer for Cone {
         fn blocked(&self, _g: &ShaderGlobals, d: Vec3, tmax: f32, only_local: bool) -> bool {
             !only_local && tmax > 0.5 && d.z > self.cos_max
+        }
+
+        fn local_hits(
+            &self,
+            _g: &ShaderGlobals,
+            _o: Vec3,
+            _d: Vec3,
+            _tmax: f32,
+            _hits: &mut [crate::shading::globals::LocalHit],
+        ) -> usize {
+            0
         }
     }
 
@@ -137,7 +148,7 @@ mod tests {
             images: &[],
             textures: &[],
             camera_to_world: glam::Mat4::IDENTITY,
-            occluder: Some(&cone),
+            tracer: Some(&cone),
         };
         let n = 4000;
         let mean: f32 = (0..n)
@@ -158,7 +169,7 @@ mod tests {
             1.0
         );
         let none = ShadeEnv {
-            occluder: None,
+            tracer: None,
             ..env
         };
         assert_eq!(
@@ -182,7 +193,7 @@ mod tests {
             images: &[],
             textures: &[],
             camera_to_world: glam::Mat4::IDENTITY,
-            occluder: Some(&cone),
+            tracer: Some(&cone),
         };
         let worst = (0..500)
             .map(|i| (ambient_occlusion(&at_origin(i), &env, Vec3::Z, 1.0, 16, false) - 0.36).abs())

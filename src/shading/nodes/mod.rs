@@ -1,6 +1,7 @@
 //! Node families: each file compiles its nodes into operations and evaluates them.
 
 pub mod ao;
+pub mod bevel;
 pub mod bsdf;
 pub mod bump;
 pub mod color;
@@ -35,6 +36,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         transform::compile,
         wireframe::compile,
         ao::compile,
+        bevel::compile,
         bump::compile,
         displacement::compile,
         convert::compile,

@@ -435,7 +435,7 @@ mod tests {
             images: &[],
             textures: &[],
             camera_to_world: cam,
-            occluder: None,
+            tracer: None,
         };
         let g = ShaderGlobals::at(Vec3::ZERO, Vec3::Y, glam::Vec2::ZERO);
         let p = Vec3::new(0.0, 3.0, 1.0);
