@@ -504,6 +504,16 @@ for depth in (0, 1, 2, 5, 10):
 case("magic-fac", tex("ShaderNodeTexMagic", "Fac", {"turbulence_depth": 3}, vector=P3,
                       Scale=2.5, Distortion=2.5))
 
+# Gabor (Blender 4.3+): 2D and 3D, isotropic to fully anisotropic, each output.
+GABOR = [("2D", 0.0, {"Orientation 2D": 0.6}), ("2D", 0.7, {"Orientation 2D": -1.1}),
+         ("2D", 1.0, {}), ("3D", 0.0, {}), ("3D", 0.6, {"Orientation 3D": (0.3, -0.5, 0.8)}),
+         ("3D", 1.0, {"Orientation 3D": (0.0, 0.0, 1.0)})]
+for gtype, aniso, extra in GABOR:
+    for output in ("Value", "Phase", "Intensity"):
+        case("gabor-%s-aniso%g-%s" % (gtype, aniso, output.lower()),
+             tex("ShaderNodeTexGabor", output, {"gabor_type": gtype}, vector=P3, Scale=2.5,
+                 Frequency=2.5, Anisotropy=aniso, **extra), disc=output == "Phase")
+
 BRICK = {"Color1": (0.8, 0.2, 0.1, 1.0), "Color2": (0.2, 0.6, 0.3, 1.0),
          "Mortar": (0.05, 0.05, 0.1, 1.0), "Scale": 2.5}
 for output in ("Color", "Fac"):

@@ -1,10 +1,12 @@
 //! Procedural texture nodes (Noise, White Noise, Voronoi, Checker, Gradient, Wave, Magic,
-//! Brick): the compile glue around the algorithms in [`crate::shading::tex`]. An unlinked
+//! Brick, Gabor): the compile glue around the algorithms in [`crate::shading::tex`]. An unlinked
 //! Vector input reads Generated coordinates, as in Cycles.
 
 use crate::shading::compile::{CompileError, NodeCx, SocketType};
 use crate::shading::program::{Op, Slot, Slots};
-use crate::shading::tex::{brick, checker, gradient, magic, noise, voronoi, wave, white_noise};
+use crate::shading::tex::{
+    brick, checker, gabor, gradient, magic, noise, voronoi, wave, white_noise,
+};
 use glam::Vec3;
 
 /// A texture's settings: menus and flags from the node's properties.
@@ -34,6 +36,9 @@ pub enum Kind {
     },
     Magic {
         depth: i32,
+    },
+    Gabor {
+        three_d: bool,
     },
     Brick {
         offset: f32,
@@ -96,6 +101,13 @@ fn inputs_of(kind: &Kind) -> &'static [(&'static str, f32, bool)] {
             ("Phase Offset", 0.0, false),
         ],
         Kind::Magic { .. } => &[("Scale", 5.0, false), ("Distortion", 1.0, false)],
+        // Orientation 3D, a vector, follows these (see `compile`).
+        Kind::Gabor { .. } => &[
+            ("Scale", 5.0, false),
+            ("Frequency", 2.0, false),
+            ("Anisotropy", 1.0, false),
+            ("Orientation 2D", std::f32::consts::FRAC_PI_4, false),
+        ],
         Kind::Brick { .. } => &[
             ("Color1", 0.8, true),
             ("Color2", 0.2, true),
@@ -123,6 +135,7 @@ fn outputs_of(kind: &Kind) -> &'static [(&'static str, SocketType)] {
             ("W", Float),
             ("Radius", Float),
         ],
+        Kind::Gabor { .. } => &[("Value", Float), ("Phase", Float), ("Intensity", Float)],
         _ => &[("Color", Color), ("Fac", Float)],
     }
 }
@@ -212,6 +225,11 @@ impl TextureOp {
                 let (col, fac) = magic::magic(p, depth, f(0), f(1));
                 (fac, col, Vec3::ZERO, 0.0, 0.0)
             }
+            Kind::Gabor { three_d } => {
+                let (value, phase, intensity) =
+                    gabor::gabor(p, f(0), f(1), f(2), three_d, f(3), v(4));
+                (value, Vec3::ZERO, Vec3::ZERO, phase, intensity)
+            }
             Kind::Brick {
                 offset,
                 offset_frequency,
@@ -241,6 +259,11 @@ impl TextureOp {
             Kind::Noise { .. } | Kind::WhiteNoise { .. } => {
                 s.set_f(self.outputs[0], a);
                 s.set_v(self.outputs[1], b);
+            }
+            Kind::Gabor { .. } => {
+                s.set_f(self.outputs[0], a);
+                s.set_f(self.outputs[1], d);
+                s.set_f(self.outputs[2], e);
             }
             Kind::Voronoi { .. } => {
                 s.set_f(self.outputs[0], a);
@@ -359,6 +382,9 @@ fn kind_of(kind: &str, cx: &mut NodeCx) -> Option<Kind> {
                 },
             }
         }
+        "ShaderNodeTexGabor" => Kind::Gabor {
+            three_d: cx.prop_str("gabor_type") == Some("3D"),
+        },
         "ShaderNodeTexMagic" => Kind::Magic {
             depth: cx.prop_f32("turbulence_depth", 2.0) as i32,
         },
@@ -400,6 +426,11 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         } else {
             cx.float(id, default)?
         };
+    }
+    if let Kind::Gabor { .. } = k {
+        let n = inputs_of(&k).len();
+        let diagonal = Vec3::new(1.0, 1.0, 0.0) * std::f32::consts::FRAC_1_SQRT_2;
+        inputs[n] = cx.vector("Orientation 3D", diagonal)?;
     }
     let mut outputs = [0; MAX_OUT];
     let partial = matches!(

@@ -4,6 +4,7 @@
 
 pub mod brick;
 pub mod checker;
+pub mod gabor;
 pub mod gradient;
 pub mod hash;
 pub mod magic;
