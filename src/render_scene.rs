@@ -1164,6 +1164,7 @@ impl RenderScene {
                 | ClosureKind::Glass { color, .. }
                 | ClosureKind::Refraction { color, .. }
                 | ClosureKind::Translucent { color }
+                | ClosureKind::Toon { color, .. }
                 | ClosureKind::Transparent { color } => color,
                 ClosureKind::Subsurface { .. } => Vec3::ONE,
             }

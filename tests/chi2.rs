@@ -16,7 +16,7 @@ use tesela::bsdf::microfacet::{
 };
 use tesela::bsdf::{
     Bsdf, BsdfQueryRecord, Coat, ConductorFresnel, Dielectric, Diffuse, Layered, Measure, Mirror,
-    Plastic, RoughConductor, RoughDielectric, Sheen, Translucent, Transparent,
+    Plastic, RoughConductor, RoughDielectric, Sheen, Toon, Translucent, Transparent,
 };
 use tesela::emitter::{
     AreaEmitter, Background, Directional, Emitter, EmitterQueryRecord, LightChoice, LightSampler,
@@ -1532,6 +1532,36 @@ fn layered_sampling() {
                 alpha_case,
             );
             assert!(r.integral <= 1.0 + 1e-3, "∫pdf = {}", r.integral);
+        }
+    }
+}
+
+#[test]
+fn toon_sampling() {
+    // Diffuse Toon: a cone about the normal; Glossy Toon: about the mirror direction, clipped
+    // by the horizon at grazing views (the clipped samples fall in the rest bin).
+    let cases = [
+        (false, 0.5, 0.0, 40.0),
+        (false, 0.3, 0.4, 70.0),
+        (false, 0.9, 0.5, 20.0),
+        (true, 0.2, 0.1, 30.0),
+        (true, 0.4, 0.3, 75.0),
+        (true, 0.05, 0.0, 50.0),
+    ];
+    let alpha_case = sidak(SIGNIFICANCE, cases.len());
+    for (k, &(glossy, size, smooth, theta)) in cases.iter().enumerate() {
+        let b = Toon::new(Vec3::new(0.8, 0.5, 0.2), size, smooth, glossy);
+        let r = check_bsdf(
+            &format!("Toon glossy={glossy} size={size} smooth={smooth} θi={theta}°"),
+            &b,
+            dir_at(theta),
+            &DirGrid::sphere(60, 120),
+            2900 + k as u64,
+            alpha_case,
+        );
+        if !glossy {
+            assert!((r.integral - 1.0).abs() < 2e-3, "∫pdf = {}", r.integral);
+            assert_eq!(r.rest_fraction, 0.0);
         }
     }
 }

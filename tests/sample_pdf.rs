@@ -8,7 +8,7 @@ use glam::{Vec2, Vec3};
 use tesela::bsdf::microfacet::anisotropy;
 use tesela::bsdf::{
     BaseLobe, Bsdf, BsdfInstance, BsdfQueryRecord, Coat, ConductorFresnel, Dielectric, Diffuse,
-    Layered, Measure, Mirror, Plastic, RoughConductor, RoughDielectric, Sheen, SurfaceParams,
+    Layered, Measure, Mirror, Plastic, RoughConductor, RoughDielectric, Sheen, SurfaceParams, Toon,
     TopLobe, Translucent, Transparent, choose,
 };
 use tesela::emitter::{
@@ -277,6 +277,13 @@ fn blender_lobes_sample_pdf_and_weight_agree() {
         );
     }
     run("Translucent".into(), &Translucent::new(c), true);
+    for glossy in [false, true] {
+        run(
+            format!("Toon glossy={glossy}"),
+            &Toon::new(c, 0.3, 0.2, glossy),
+            false,
+        );
+    }
     for r in [0.01f32, 0.2, 0.5, 1.0] {
         run(format!("Sheen r={r}"), &Sheen::new(c, r), false);
     }

@@ -4,8 +4,8 @@ use super::microfacet::anisotropy;
 use super::sheen::Sheen;
 use super::{
     BaseLobe, BsdfInstance, Coat, DELTA_ALPHA, Dielectric, Diffuse, Layered, Mirror, Plastic,
-    RoughConductor, RoughDielectric, SurfaceParams, TopLobe, Translucent, Transparent, choose,
-    principled_specular_ior,
+    RoughConductor, RoughDielectric, SurfaceParams, Toon, TopLobe, Translucent, Transparent,
+    choose, principled_specular_ior,
 };
 use crate::shading::{Closure, ClosureKind, Principled};
 use glam::Vec3;
@@ -141,6 +141,12 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
             )
         }
         ClosureKind::Translucent { color } => BsdfInstance::Translucent(Translucent::new(*color)),
+        ClosureKind::Toon {
+            color,
+            size,
+            smooth,
+            glossy,
+        } => BsdfInstance::Toon(Toon::new(*color, *size, *smooth, *glossy)),
         ClosureKind::Transparent { color } => BsdfInstance::Transparent(Transparent::new(*color)),
         // Where it is not walked, subsurface scattering is diffuse (the colour is the weight).
         ClosureKind::Subsurface { .. } => BsdfInstance::Diffuse(Diffuse::new(Vec3::ONE)),

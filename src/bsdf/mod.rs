@@ -17,6 +17,7 @@ pub mod plastic;
 pub mod rough_dielectric;
 pub mod sheen;
 pub mod tables;
+pub mod toon;
 pub mod translucent;
 pub mod transparent;
 
@@ -31,6 +32,7 @@ pub use mirror::Mirror;
 pub use plastic::Plastic;
 pub use rough_dielectric::{DielectricMode, RoughDielectric, principled_specular_ior};
 pub use sheen::Sheen;
+pub use toon::Toon;
 pub use translucent::Translucent;
 pub use transparent::Transparent;
 
@@ -121,6 +123,7 @@ pub enum BsdfInstance {
     Plastic(Plastic),
     RoughDielectric(RoughDielectric),
     Translucent(Translucent),
+    Toon(Toon),
     Transparent(Transparent),
     Sheen(Sheen),
     /// A coat or sheen over a base lobe ([`layered`]).
@@ -137,6 +140,7 @@ macro_rules! dispatch {
             BsdfInstance::Plastic($b) => $e,
             BsdfInstance::RoughDielectric($b) => $e,
             BsdfInstance::Translucent($b) => $e,
+            BsdfInstance::Toon($b) => $e,
             BsdfInstance::Transparent($b) => $e,
             BsdfInstance::Sheen($b) => $e,
             BsdfInstance::Layered($b) => $e,

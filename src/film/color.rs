@@ -21,6 +21,14 @@ pub fn closure_colors(c: &Closure, mu: f32, backfacing: bool) -> [Vec3; 3] {
         ClosureKind::Diffuse { color } | ClosureKind::Translucent { color } => {
             put(LightClass::Diffuse, color)
         }
+        ClosureKind::Toon { color, glossy, .. } => {
+            let class = if glossy {
+                LightClass::Glossy
+            } else {
+                LightClass::Diffuse
+            };
+            put(class, color)
+        }
         // Blender's Glossy BSDF has no Fresnel: its colour is its albedo estimate.
         ClosureKind::Glossy { color, .. } => put(LightClass::Glossy, color),
         ClosureKind::Glass {

@@ -36,7 +36,8 @@ fn closure_albedo(c: &Closure) -> Option<Vec3> {
         | ClosureKind::Glossy { color, .. }
         | ClosureKind::Glass { color, .. }
         | ClosureKind::Refraction { color, .. }
-        | ClosureKind::Translucent { color } => color,
+        | ClosureKind::Translucent { color }
+        | ClosureKind::Toon { color, .. } => color,
         ClosureKind::Subsurface { .. } => Vec3::ONE,
         ClosureKind::Transparent { .. } => return None,
     };

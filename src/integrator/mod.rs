@@ -355,6 +355,8 @@ impl ShadingPoint {
             }
             // Cycles counts translucent among the diffuse closures (CLOSURE_IS_BSDF_DIFFUSE).
             BsdfInstance::Translucent(_) => ray::DIFFUSE,
+            BsdfInstance::Toon(t) if t.glossy => ray::GLOSSY,
+            BsdfInstance::Toon(_) => ray::DIFFUSE,
             BsdfInstance::Transparent(_) => ray::TRANSMISSION,
             BsdfInstance::Sheen(_) => ray::DIFFUSE,
             BsdfInstance::Layered(_) => ray::DIFFUSE | ray::GLOSSY | ray::TRANSMISSION,
@@ -508,10 +510,11 @@ impl ShadingPoint {
     /// The chosen BSDF is one of Cycles' diffuse closures (`CLOSURE_IS_BSDF_DIFFUSE`).
     #[inline]
     fn diffuse_lobe(&self) -> bool {
-        matches!(
-            self.bsdf,
-            BsdfInstance::Diffuse(_) | BsdfInstance::Translucent(_)
-        )
+        match self.bsdf {
+            BsdfInstance::Diffuse(_) | BsdfInstance::Translucent(_) => true,
+            BsdfInstance::Toon(t) => !t.glossy,
+            _ => false,
+        }
     }
 
     /// Cycles' correction for a closure normal that differs from the interpolated one `ns`
@@ -576,6 +579,7 @@ impl ShadingPoint {
             BsdfInstance::Diffuse(_) | BsdfInstance::Translucent(_) | BsdfInstance::Sheen(_) => {
                 true
             }
+            BsdfInstance::Toon(t) => !t.glossy,
             BsdfInstance::Plastic(p) => wi.z > 0.0 && u1 >= p.coat_share(wi.z),
             BsdfInstance::Layered(l) => {
                 let (top, u2) = l.pick(wi, u1);

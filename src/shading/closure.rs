@@ -106,6 +106,14 @@ pub enum ClosureKind {
     Translucent {
         color: Vec3,
     },
+    /// Blender's Toon BSDF: Size and Smooth as the node gives them (fractions of a right
+    /// angle), about the normal or (Glossy) the mirror direction.
+    Toon {
+        color: Vec3,
+        size: f32,
+        smooth: f32,
+        glossy: bool,
+    },
     /// Subsurface scattering (Blender's Subsurface Scattering node): a random walk below the
     /// surface; its colour is in the closure's weight, and also its albedo here.
     Subsurface {

@@ -597,6 +597,26 @@ def bevel_box():
     scenes.add_camera((1.1, -1.4, 1.6), (0.1, -0.1, 0.6), fov=math.radians(40.0))
 
 
+def toon_ball(component):
+    """The Toon BSDF on the ball: Diffuse (size 0.4, smooth 0.1), or Glossy (size 0.15,
+    smooth 0.1) added to a dark Diffuse, under the sun and a dim world."""
+    def build():
+        mat, nt, out = node_material("Toon_" + component)
+        size = 0.4 if component == "DIFFUSE" else 0.15
+        toon = node(nt, "ShaderNodeBsdfToon", {"component": component},
+                    Color=(0.8, 0.4, 0.2, 1.0), Size=size, Smooth=0.1)
+        if component == "DIFFUSE":
+            surface(nt, out, toon.outputs[0])
+        else:
+            dif = node(nt, "ShaderNodeBsdfDiffuse", Color=(0.1, 0.1, 0.15, 1.0))
+            add = node(nt, "ShaderNodeAddShader")
+            nt.links.new(dif.outputs[0], add.inputs[0])
+            nt.links.new(toon.outputs[0], add.inputs[1])
+            surface(nt, out, add.outputs[0])
+        _sphere_stage(mat)
+    return build
+
+
 def sheen_bsdf():
     """The Sheen BSDF added to a dark Diffuse: the fabric look."""
     mat, nt, out = node_material("Velvet")
@@ -680,6 +700,8 @@ CASES = [
     ("ambient_occlusion_floor", ambient_occlusion(), 2, 128, 512),
     ("ambient_occlusion_inside_local", ambient_occlusion(True), 0, 128, 512),
     ("bevel_box_edges", bevel_box, 0, 256, 1024),
+    ("toon_diffuse_ball", toon_ball("DIFFUSE"), 0, 128, 512),
+    ("toon_glossy_ball", toon_ball("GLOSSY"), 0, 256, 1024),
     ("metallic_bsdf_f82_anisotropic", metallic_bsdf("F82"), 0, 256, 1024),
     ("metallic_bsdf_physical_conductor", metallic_bsdf("PHYSICAL_CONDUCTOR"), 0, 256, 1024),
     pytest.param(("sheen_bsdf_over_diffuse", sheen_bsdf, 0, 256, 1024),

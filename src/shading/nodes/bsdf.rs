@@ -111,6 +111,13 @@ pub enum ClosureParams {
         color: Slot,
         normal: Option<Slot>,
     },
+    Toon {
+        color: Slot,
+        size: Slot,
+        smooth: Slot,
+        normal: Option<Slot>,
+        glossy: bool,
+    },
     Transparent {
         color: Slot,
     },
@@ -363,6 +370,24 @@ impl ClosureOp {
                 normal(*n),
                 Vec3::ZERO,
                 ClosureKind::Translucent { color: Vec3::ONE },
+            ),
+            ClosureParams::Toon {
+                color,
+                size,
+                smooth,
+                normal: n,
+                glossy,
+            } => push(
+                out,
+                col(*color) * w,
+                normal(*n),
+                Vec3::ZERO,
+                ClosureKind::Toon {
+                    color: Vec3::ONE,
+                    size: s.f(*size),
+                    smooth: s.f(*smooth),
+                    glossy: *glossy,
+                },
             ),
             ClosureParams::Transparent { color } => push(
                 out,
@@ -619,6 +644,13 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
             normal: normal(cx, "Normal")?,
             refraction_only: kind == "ShaderNodeBsdfRefraction",
             multiscatter: cx.prop_str("distribution").unwrap_or("MULTI_GGX") == "MULTI_GGX",
+        },
+        "ShaderNodeBsdfToon" => ClosureParams::Toon {
+            color: cx.color("Color", Vec3::splat(0.8))?,
+            size: cx.float("Size", 0.5)?,
+            smooth: cx.float("Smooth", 0.0)?,
+            normal: normal(cx, "Normal")?,
+            glossy: cx.prop_str("component") == Some("GLOSSY"),
         },
         "ShaderNodeBsdfTranslucent" => ClosureParams::Translucent {
             color: cx.color("Color", Vec3::splat(0.8))?,
