@@ -119,6 +119,11 @@ struct RenderArgs {
     /// Tile edge in pixels.
     #[arg(long, default_value_t = 32)]
     tile_size: u32,
+    /// A mesh placed several times is baked into world space while its copies together have at
+    /// most this many triangles, else instanced (0: instance every repeated mesh). A tuning
+    /// knob (bench/bake_limit.py measures it); the default is the measured break-even.
+    #[arg(long, default_value_t = scene::gltf::LoadOptions::default().bake_triangles)]
+    bake_triangles: usize,
     /// Stream binary frames on stdout for the Blender add-on (docs/protocol.md); stops when
     /// stdin closes.
     #[arg(long)]
@@ -531,7 +536,12 @@ fn load_scene_file(args: &RenderArgs) -> Result<Scene, String> {
         });
     }
     match &args.scene {
-        Some(path) => scene::gltf::load(path).map_err(|e| e.to_string()),
+        Some(path) => {
+            let options = scene::gltf::LoadOptions {
+                bake_triangles: args.bake_triangles,
+            };
+            scene::gltf::load_with(path, &options).map_err(|e| e.to_string())
+        }
         None => Ok(scene::builtin::cornell_box()),
     }
 }

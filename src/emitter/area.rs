@@ -227,6 +227,9 @@ fn radiance(
             let n = mesh.shading_normal(tri, b.x, b.y).unwrap_or(ng);
             let mut g = ShaderGlobals::at(p, n, uv);
             g.ng = to_blender(if ng.dot(n) < 0.0 { -ng } else { ng });
+            // No ray: a nominal metre, so an emission scaled by the ray length (Light
+            // Falloff's Linear and Constant) still counts in the light choice.
+            g.ray_length = 1.0;
             g
         }
     };

@@ -494,6 +494,24 @@ def emission_room():
     scenes.add_camera((0.0, -0.95, 1.0), (0.0, 1.0, 0.9), fov=math.radians(80.0))
 
 
+def emission_light_falloff():
+    """A floor and a back wall lit by a 0.6 m panel 1.2 m up whose Emission strength is a Light
+    Falloff node's Linear output (strength 6, smooth 0.3): brighter with the distance each ray
+    travels to it, and softened near it; the camera sees the panel too."""
+    white = lambert_mat("White", (0.7, 0.7, 0.7))
+    scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)], white)
+    scenes.add_quad("Back", [(-3, 1.5, 0), (3, 1.5, 0), (3, 1.5, 3), (-3, 1.5, 3)], white)
+    mat, nt, out = node_material("FalloffPanel")
+    fall = node(nt, "ShaderNodeLightFalloff", Strength=6.0, Smooth=0.3)
+    em = node(nt, "ShaderNodeEmission", Color=(1.0, 0.9, 0.8, 1.0),
+              Strength=fall.outputs["Linear"])
+    surface(nt, out, em.outputs[0])
+    scenes.add_quad("Panel", [(-0.3, -0.3, 1.2), (-0.3, 0.3, 1.2), (0.3, 0.3, 1.2),
+                              (0.3, -0.3, 1.2)], mat)
+    world(0.0)
+    scenes.add_camera((0.0, -3.0, 1.6), (0.0, 0.5, 0.6), fov=math.radians(50.0))
+
+
 def principled_variant(kind):
     def build():
         mat, nt, out = node_material("P_" + kind)
@@ -694,6 +712,7 @@ CASES = [
     ("noise_color_ramp_diffuse", lambda: noise_ramp_floor("diffuse"), 0, 64, 256),
     ("vertex_colour_second_uv", vertex_colour_uv2, 0, 64, 256),
     ("emission_image_room", emission_room, 3, 256, 2048),
+    ("emission_light_falloff", emission_light_falloff, 2, 256, 1024),
     ("principled_coat", principled_variant("coat"), 0, 256, 1024),
     ("principled_sheen", principled_variant("sheen"), 0, 256, 1024),
     ("wireframe_ball", wireframe_ball, 0, 128, 512),

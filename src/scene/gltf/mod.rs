@@ -98,6 +98,11 @@ const UNDERSTOOD: &[&str] = &[
 /// Loads a `.gltf` or `.glb` file. External files are resolved relative to its folder
 /// and must lie inside it.
 pub fn load(path: &Path) -> Result<Scene, LoadError> {
+    load_with(path, &LoadOptions::default())
+}
+
+/// [`load`] with explicit [`LoadOptions`].
+pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, LoadError> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| {
         LoadError::new(LoadErrorKind::Io, format!("cannot read the file: {e}")).in_file(&name)
@@ -106,7 +111,7 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    load_from_slice(&bytes, Some(base), &name)
+    load_from_slice_with(&bytes, Some(base), &name, options)
 }
 
 /// How a load turns the file into a scene.

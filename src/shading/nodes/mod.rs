@@ -11,6 +11,7 @@ pub mod displacement;
 pub mod environment;
 pub mod image;
 pub mod input;
+pub mod light_falloff;
 pub mod map_range;
 pub mod math;
 pub mod mix;
@@ -35,6 +36,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         vector::compile,
         transform::compile,
         wireframe::compile,
+        light_falloff::compile,
         ao::compile,
         bevel::compile,
         bump::compile,
