@@ -134,15 +134,7 @@ impl crate::shading::globals::Tracer for RenderScene {
         }
         let mut tmin = 0.0;
         for _ in 0..MAX_LOCAL_SKIPS {
-            let hit = self.accel.intersect_with(&mut trav, o, d, tmin, tmax);
-            let hit = match &self.instances {
-                None => hit,
-                Some(inst) => {
-                    let t = hit.map_or(tmax, |h| h.t);
-                    inst.intersect_with(&mut top, &mut trav, o, d, tmin, t)
-                        .or(hit)
-                }
-            };
+            let hit = self.closest_with(&mut trav, &mut top, o, d, tmin, tmax);
             let Some(hit) = hit else { return false };
             if [hit.key[0], hit.instance] == g.object {
                 return true;
@@ -169,15 +161,7 @@ impl crate::shading::globals::Tracer for RenderScene {
             if n == hits.len() {
                 break;
             }
-            let hit = self.accel.intersect_with(&mut trav, o, d, tmin, tmax);
-            let hit = match &self.instances {
-                None => hit,
-                Some(inst) => {
-                    let t = hit.map_or(tmax, |h| h.t);
-                    inst.intersect_with(&mut top, &mut trav, o, d, tmin, t)
-                        .or(hit)
-                }
-            };
+            let hit = self.closest_with(&mut trav, &mut top, o, d, tmin, tmax);
             let Some(hit) = hit else { break };
             tmin = hit.t;
             if [hit.key[0], hit.instance] == g.object {
@@ -784,13 +768,26 @@ impl RenderScene {
     /// [`Self::closest`] in `(tmin, tmax)`.
     #[inline(always)]
     fn closest_after(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
-        let hit = self.accel.intersect_with(&mut ctx.trav, o, d, tmin, tmax);
+        self.closest_with(&mut ctx.trav, &mut ctx.trav_top, o, d, tmin, tmax)
+    }
+
+    /// [`Self::closest_after`] on the given traversal states (bottom level, top level).
+    #[inline(always)]
+    fn closest_with(
+        &self,
+        trav: &mut Traversal,
+        top: &mut Traversal,
+        o: Vec3,
+        d: Vec3,
+        tmin: f32,
+        tmax: f32,
+    ) -> Option<Hit> {
+        let hit = self.accel.intersect_with(trav, o, d, tmin, tmax);
         let Some(inst) = &self.instances else {
             return hit;
         };
         let t = hit.map_or(tmax, |h| h.t);
-        inst.intersect_with(&mut ctx.trav_top, &mut ctx.trav, o, d, tmin, t)
-            .or(hit)
+        inst.intersect_with(top, trav, o, d, tmin, t).or(hit)
     }
 
     /// The closest surface of one object — mesh `mesh` placed by `instance` — along the unit

@@ -132,6 +132,15 @@ mod tests {
         }
     }
 
+    fn env_with(tracer: &dyn Tracer) -> ShadeEnv<'_> {
+        ShadeEnv {
+            images: &[],
+            textures: &[],
+            camera_to_world: glam::Mat4::IDENTITY,
+            tracer: Some(tracer),
+        }
+    }
+
     fn at_origin(seed: u32) -> ShaderGlobals<'static> {
         let mut g = ShaderGlobals::at(Vec3::ZERO, Vec3::Y, Vec2::ZERO); // Blender +Z
         g.object = [0, u32::MAX];
@@ -144,12 +153,7 @@ mod tests {
         // Cosine-weighted directions: P(cos θ > c) = 1 - c². Averaged over many points (seeds)
         // the fraction left open is c²; a uniform-hemisphere sampler would give c.
         let cone = Cone { cos_max: 0.6 };
-        let env = ShadeEnv {
-            images: &[],
-            textures: &[],
-            camera_to_world: glam::Mat4::IDENTITY,
-            tracer: Some(&cone),
-        };
+        let env = env_with(&cone);
         let n = 4000;
         let mean: f32 = (0..n)
             .map(|i| ambient_occlusion(&at_origin(i), &env, Vec3::Z, 1.0, 16, false))
@@ -189,12 +193,7 @@ mod tests {
         // Sixteen scrambled (0,2) points: the open fraction of one point is within a couple
         // of samples of the expectation (independent samples: a standard deviation of 0.12).
         let cone = Cone { cos_max: 0.6 };
-        let env = ShadeEnv {
-            images: &[],
-            textures: &[],
-            camera_to_world: glam::Mat4::IDENTITY,
-            tracer: Some(&cone),
-        };
+        let env = env_with(&cone);
         let worst = (0..500)
             .map(|i| (ambient_occlusion(&at_origin(i), &env, Vec3::Z, 1.0, 16, false) - 0.36).abs())
             .fold(0.0f32, f32::max);
