@@ -395,6 +395,16 @@ impl<'g> NodeCx<'_, 'g> {
         matches!(self.node().input(id), Some(Input::Link { .. }))
     }
 
+    /// Vector input `id` when it is linked (inputs such as Normal whose unlinked value is the
+    /// shading point's own, not the socket's constant); `None` when unlinked.
+    pub fn linked_vector(&mut self, id: &str) -> Result<Option<Slot>> {
+        if self.is_linked(id) {
+            self.vector(id, Vec3::ZERO).map(Some)
+        } else {
+            Ok(None)
+        }
+    }
+
     /// Input `id` as a slot of type `ty`: its link, its constant, or `default`.
     pub fn input(&mut self, id: &str, ty: SocketType, default: &[f32]) -> Result<Slot> {
         match self.node().input(id) {

@@ -79,11 +79,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
     }
     let color = cx.color("Color", Vec3::ONE)?;
     let distance = cx.float("Distance", 1.0)?;
-    let normal = if cx.is_linked("Normal") {
-        Some(cx.vector("Normal", Vec3::ZERO)?)
-    } else {
-        None
-    };
+    let normal = cx.linked_vector("Normal")?;
     let samples = cx.prop_f32("samples", 16.0).clamp(1.0, MAX_SAMPLES as f32) as u32;
     let out_color = cx.output("Color", SocketType::Color)?;
     let out_ao = cx.output("AO", SocketType::Float)?;

@@ -135,11 +135,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         return Ok(false);
     }
     let radius = cx.float("Radius", 0.05)?;
-    let normal = if cx.is_linked("Normal") {
-        Some(cx.vector("Normal", Vec3::ZERO)?)
-    } else {
-        None
-    };
+    let normal = cx.linked_vector("Normal")?;
     let samples = cx.prop_f32("samples", 4.0).clamp(1.0, MAX_SAMPLES as f32) as u32;
     let out = cx.output("Normal", SocketType::Vector)?;
     cx.emit(

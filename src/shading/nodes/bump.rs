@@ -100,11 +100,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
     let strength = cx.float("Strength", 1.0)?;
     let distance = cx.float("Distance", 1.0)?;
     let invert = cx.prop_bool("invert", false);
-    let normal = if cx.is_linked("Normal") {
-        Some(cx.vector("Normal", Vec3::ZERO)?)
-    } else {
-        None
-    };
+    let normal = cx.linked_vector("Normal")?;
     let out = cx.output("Normal", SocketType::Vector)?;
     if !cx.is_linked("Height") {
         // A constant height bumps nothing.

@@ -121,11 +121,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             let height = cx.float("Height", 0.0)?;
             let midlevel = cx.float("Midlevel", 0.5)?;
             let scale = cx.float("Scale", 1.0)?;
-            let normal = if cx.is_linked("Normal") {
-                Some(cx.vector("Normal", Vec3::ZERO)?)
-            } else {
-                None
-            };
+            let normal = cx.linked_vector("Normal")?;
             let space = space(cx, "OBJECT");
             let out = cx.output("Displacement", SocketType::Vector)?;
             DisplacementOp::Scalar {

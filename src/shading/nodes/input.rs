@@ -313,11 +313,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         }
         "ShaderNodeLayerWeight" => {
             let blend = cx.float("Blend", 0.5)?;
-            let normal = if cx.is_linked("Normal") {
-                Some(cx.vector("Normal", Vec3::ZERO)?)
-            } else {
-                None
-            };
+            let normal = cx.linked_vector("Normal")?;
             for (id, fresnel) in [("Fresnel", true), ("Facing", false)] {
                 emit(
                     cx,
@@ -333,11 +329,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         }
         "ShaderNodeFresnel" => {
             let ior = cx.float("IOR", 1.5)?;
-            let normal = if cx.is_linked("Normal") {
-                Some(cx.vector("Normal", Vec3::ZERO)?)
-            } else {
-                None
-            };
+            let normal = cx.linked_vector("Normal")?;
             emit(cx, "Fac", Float, Source::Fresnel { ior, normal })?;
         }
         "ShaderNodeValue" => {
