@@ -126,22 +126,16 @@ impl crate::shading::globals::Tracer for RenderScene {
         use crate::shading::globals::from_blender;
         let d = from_blender(d);
         let o = offset_origin(from_blender(g.p), from_blender(g.ng), d);
-        let (mut trav, mut top) = (Traversal::default(), Traversal::default());
         if !only_local {
-            return self.accel.occluded_with(&mut trav, o, d, 0.0, tmax)
-                || (self.instances.as_ref())
-                    .is_some_and(|i| i.occluded_with(&mut top, &mut trav, o, d, 0.0, tmax));
+            let (mut trav, mut top) = (Traversal::default(), Traversal::default());
+            return self.occluded_with(&mut trav, &mut top, o, d, tmax);
         }
-        let mut tmin = 0.0;
-        for _ in 0..MAX_LOCAL_SKIPS {
-            let hit = self.closest_with(&mut trav, &mut top, o, d, tmin, tmax);
-            let Some(hit) = hit else { return false };
-            if [hit.key[0], hit.instance] == g.object {
-                return true;
-            }
-            tmin = hit.t;
-        }
-        false
+        let mut found = false;
+        self.each_local_hit(g.object, o, d, tmax, MAX_LOCAL_SKIPS, |_| {
+            found = true;
+            false
+        });
+        found
     }
 
     fn local_hits(
@@ -154,26 +148,22 @@ impl crate::shading::globals::Tracer for RenderScene {
     ) -> usize {
         use crate::shading::globals::{LocalHit, from_blender};
         let (o, d) = (from_blender(o), from_blender(d));
-        let (mut trav, mut top) = (Traversal::default(), Traversal::default());
-        let (mut tmin, mut n) = (0.0, 0);
-        // Other objects' surfaces count towards the steps too: a bounded loop.
-        for _ in 0..(hits.len() as u32 + MAX_LOCAL_SKIPS) {
-            if n == hits.len() {
-                break;
-            }
-            let hit = self.closest_with(&mut trav, &mut top, o, d, tmin, tmax);
-            let Some(hit) = hit else { break };
-            tmin = hit.t;
-            if [hit.key[0], hit.instance] == g.object {
-                let its = self.intersection(&hit, d);
-                hits[n] = LocalHit {
-                    p: to_blender(its.p),
-                    n: to_blender(its.ns),
-                    ng: to_blender(its.ng),
-                };
-                n += 1;
-            }
+        if hits.is_empty() {
+            return 0;
         }
+        let mut n = 0;
+        // Other objects' surfaces count towards the steps too: a bounded walk.
+        let steps = hits.len() as u32 + MAX_LOCAL_SKIPS;
+        self.each_local_hit(g.object, o, d, tmax, steps, |hit| {
+            let its = self.intersection(hit, d);
+            hits[n] = LocalHit {
+                p: to_blender(its.p),
+                n: to_blender(its.ns),
+                ng: to_blender(its.ng),
+            };
+            n += 1;
+            n < hits.len()
+        });
         n
     }
 }
@@ -820,10 +810,47 @@ impl RenderScene {
     /// Whether anything lies on the ray in `(0, tmax)`.
     #[inline(always)]
     fn occluded(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32) -> bool {
-        self.accel.occluded_with(&mut ctx.trav, o, d, 0.0, tmax)
-            || self.instances.as_ref().is_some_and(|inst| {
-                inst.occluded_with(&mut ctx.trav_top, &mut ctx.trav, o, d, 0.0, tmax)
-            })
+        self.occluded_with(&mut ctx.trav, &mut ctx.trav_top, o, d, tmax)
+    }
+
+    /// [`Self::occluded`] on the given traversal states (bottom level, top level).
+    #[inline(always)]
+    fn occluded_with(
+        &self,
+        trav: &mut Traversal,
+        top: &mut Traversal,
+        o: Vec3,
+        d: Vec3,
+        tmax: f32,
+    ) -> bool {
+        self.accel.occluded_with(trav, o, d, 0.0, tmax)
+            || (self.instances.as_ref())
+                .is_some_and(|inst| inst.occluded_with(top, trav, o, d, 0.0, tmax))
+    }
+
+    /// Walks the surfaces on the ray `o + t d` (renderer space, `t` in `(0, tmax)`) nearest
+    /// first, at most `steps` of them of any object, calling `visit` on those of `object`
+    /// (`[mesh, instance]`) until it returns false.
+    fn each_local_hit(
+        &self,
+        object: [u32; 2],
+        o: Vec3,
+        d: Vec3,
+        tmax: f32,
+        steps: u32,
+        mut visit: impl FnMut(&Hit) -> bool,
+    ) {
+        let (mut trav, mut top) = (Traversal::default(), Traversal::default());
+        let mut tmin = 0.0;
+        for _ in 0..steps {
+            let Some(hit) = self.closest_with(&mut trav, &mut top, o, d, tmin, tmax) else {
+                return;
+            };
+            tmin = hit.t;
+            if [hit.key[0], hit.instance] == object && !visit(&hit) {
+                return;
+            }
+        }
     }
 
     /// The radiance a ray from `o` along the unit direction `d` meets — the emission of the
