@@ -115,10 +115,9 @@ pub struct RayQuery {
 /// A hash of a hit point's coordinates: the seed of the rays its shading program casts.
 #[inline]
 fn point_seed(p: Vec3) -> u32 {
-    let h =
+    let bits =
         (p.x.to_bits() as u64) ^ ((p.y.to_bits() as u64) << 21) ^ ((p.z.to_bits() as u64) << 42);
-    let h = (h ^ (h >> 31)).wrapping_mul(0x7fb5_d329_728e_a185);
-    (h ^ (h >> 27)).wrapping_mul(0x81da_def4_bc2d_d44d) as u32 ^ (h >> 33) as u32
+    crate::sampler::hash32(bits)
 }
 
 impl crate::shading::globals::Tracer for RenderScene {

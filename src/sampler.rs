@@ -68,7 +68,7 @@ impl Sampler {
 
 /// 32-bit hash of a 64-bit value.
 #[inline]
-fn hash32(x: u64) -> u32 {
+pub(crate) fn hash32(x: u64) -> u32 {
     (mix64(x) >> 32) as u32
 }
 
