@@ -1,6 +1,11 @@
 //! Albedo and energy-compensation tables that Cycles precomputes (`cycles_precompute.cpp`, stored in
-//! `scene/shader.tables`), regenerated here from their definitions by deterministic quadrature
-//! on first use (no copied data), and read with Cycles' (bi/tri)linear `lookup_table_read_*`.
+//! `scene/shader.tables`), computed here from their definitions by deterministic quadrature (no
+//! copied data), and read with Cycles' (bi/tri)linear `lookup_table_read_*`.
+//!
+//! The quadrature takes about 0.8 CPU seconds (0.55 of it for glass), which every render would
+//! pay before its first sample; so its result is embedded (`tables.bin`, written by the test
+//! `embedded_tables_are_the_quadrature`, which also checks it), and every machine reads the same
+//! values whatever its libm.
 //!
 //! Grid conventions are Cycles': `rough = sqrt(alpha)` in `x`, `μ = cos θi` in `y`, and
 //! for IOR tables `z` with `ior = ior_from_F0(z⁴)` (so `z = sqrt(|(ior-1)/(ior+1)|)`); node
@@ -126,33 +131,30 @@ const N_IOR: usize = 16;
 /// of `ior > 1`, the mean over visible normals of `clamp((F(wi·h) - F0) / (1 - F0), 0, 1)`,
 /// counting reflections below the horizon as 0. The lobe's Fresnel estimate is then
 /// `mix(F0, 1, s)` (`bsdf_microfacet_estimate_albedo`).
-fn gen_schlick_ior_s() -> &'static [f32] {
-    static T: OnceLock<Vec<f32>> = OnceLock::new();
-    T.get_or_init(|| {
-        let n = N_IOR;
-        parallel_map(n, &|z| {
-            let zz = node(z, n).clamp(1e-4, 0.99);
-            let ior = ior_from_f0(zz * zz * zz * zz);
-            let f0 = fresnel::f0_from_ior(ior);
-            let mut t = Vec::with_capacity(n * n);
-            for y in 0..n {
-                let mu = node(y, n).clamp(1e-4, 1.0);
-                for x in 0..n {
-                    let rough = node(x, n).clamp(1e-4, 1.0);
-                    let s = vndf_mean(rough * rough, mu, &|wi, h| {
-                        let c = wi.dot(h);
-                        let wo = 2.0 * c * h - wi;
-                        if wo.z <= 0.0 || c <= 0.0 {
-                            return 0.0;
-                        }
-                        let f = fresnel::dielectric(c, ior).0;
-                        ((f - f0) / (1.0 - f0)).clamp(0.0, 1.0)
-                    });
-                    t.push(s.clamp(0.0, 1.0));
-                }
+fn compute_schlick_ior_s() -> Vec<f32> {
+    let n = N_IOR;
+    parallel_map(n, &|z| {
+        let zz = node(z, n).clamp(1e-4, 0.99);
+        let ior = ior_from_f0(zz * zz * zz * zz);
+        let f0 = fresnel::f0_from_ior(ior);
+        let mut t = Vec::with_capacity(n * n);
+        for y in 0..n {
+            let mu = node(y, n).clamp(1e-4, 1.0);
+            for x in 0..n {
+                let rough = node(x, n).clamp(1e-4, 1.0);
+                let s = vndf_mean(rough * rough, mu, &|wi, h| {
+                    let c = wi.dot(h);
+                    let wo = 2.0 * c * h - wi;
+                    if wo.z <= 0.0 || c <= 0.0 {
+                        return 0.0;
+                    }
+                    let f = fresnel::dielectric(c, ior).0;
+                    ((f - f0) / (1.0 - f0)).clamp(0.0, 1.0)
+                });
+                t.push(s.clamp(0.0, 1.0));
             }
-            t
-        })
+        }
+        t
     })
 }
 
@@ -160,7 +162,7 @@ fn gen_schlick_ior_s() -> &'static [f32] {
 /// reflection-only GGX lobe of index `ior` (either side of 1: `z` is symmetric).
 pub fn reflection_fresnel_s(alpha: f32, mu: f32, ior: f32) -> f32 {
     let z = ((ior - 1.0) / (ior + 1.0)).abs().sqrt();
-    read3(gen_schlick_ior_s(), alpha.max(0.0).sqrt(), mu, z, N_IOR)
+    read3(&tables().schlick_ior_s, alpha.max(0.0).sqrt(), mu, z, N_IOR)
 }
 
 /// Cycles' Fresnel estimate of a reflection-only GGX lobe with the dielectric Fresnel of
@@ -258,77 +260,147 @@ fn e_glass(alpha: f32, mu: f32, eta: f32, q: (usize, usize)) -> f32 {
 }
 
 /// Cycles' `ggx_E` (x = √α, y = μ) and `ggx_Eavg` (`∫ 2μ E dμ`, by 16-point Gauss–Legendre).
-fn ggx_e_tables() -> &'static (Vec<f32>, Vec<f32>) {
-    static T: OnceLock<(Vec<f32>, Vec<f32>)> = OnceLock::new();
-    T.get_or_init(|| {
-        let e = parallel_map(N_E, &|y| {
-            let mu = node(y, N_E).clamp(1e-4, 1.0);
-            (0..N_E)
-                .map(|x| {
-                    let rough = node(x, N_E).clamp(1e-4, 1.0);
-                    e_mirror(rough * rough, mu, Q).clamp(0.0, 1.0)
-                })
-                .collect()
-        });
-        let g = gauss16();
-        let avg = parallel_map(N_E, &|x| {
-            let rough = node(x, N_E).clamp(1e-4, 1.0);
-            let s: f32 = g
-                .iter()
-                .map(|&(mu, w)| w * 2.0 * mu * e_mirror(rough * rough, mu, Q_AVG))
-                .sum();
-            vec![s.clamp(0.0, 1.0)]
-        });
-        (e, avg)
-    })
+fn compute_ggx_e() -> (Vec<f32>, Vec<f32>) {
+    let e = parallel_map(N_E, &|y| {
+        let mu = node(y, N_E).clamp(1e-4, 1.0);
+        (0..N_E)
+            .map(|x| {
+                let rough = node(x, N_E).clamp(1e-4, 1.0);
+                e_mirror(rough * rough, mu, Q).clamp(0.0, 1.0)
+            })
+            .collect()
+    });
+    let g = gauss16();
+    let avg = parallel_map(N_E, &|x| {
+        let rough = node(x, N_E).clamp(1e-4, 1.0);
+        let s: f32 = g
+            .iter()
+            .map(|&(mu, w)| w * 2.0 * mu * e_mirror(rough * rough, mu, Q_AVG))
+            .sum();
+        vec![s.clamp(0.0, 1.0)]
+    });
+    (e, avg)
 }
 
 /// Cycles' `ggx_glass_E` / `ggx_glass_inv_E` (x = √α, y = μ, z as for IOR tables; `inv` for
 /// relative indices below 1) and their `Eavg` (x = √α, y = z).
-fn ggx_glass_tables(inv: bool) -> &'static (Vec<f32>, Vec<f32>) {
-    static T: [OnceLock<(Vec<f32>, Vec<f32>)>; 2] = [OnceLock::new(), OnceLock::new()];
-    T[inv as usize].get_or_init(|| {
-        let n = N_IOR;
-        let g = gauss16();
-        let ior_at = |z: usize| {
-            let zz = node(z, n).clamp(1e-4, 0.99);
-            let ior = ior_from_f0(zz * zz * zz * zz);
-            if inv { 1.0 / ior } else { ior }
-        };
-        let e = parallel_map(n, &|z| {
-            let ior = ior_at(z);
-            let mut t = Vec::with_capacity(n * n);
-            for y in 0..n {
-                let mu = node(y, n).clamp(1e-4, 1.0);
-                for x in 0..n {
-                    let rough = node(x, n).clamp(1e-4, 1.0);
-                    t.push(e_glass(rough * rough, mu, ior, Q).clamp(0.0, 1.0));
-                }
+fn compute_ggx_glass(inv: bool) -> (Vec<f32>, Vec<f32>) {
+    let n = N_IOR;
+    let g = gauss16();
+    let ior_at = |z: usize| {
+        let zz = node(z, n).clamp(1e-4, 0.99);
+        let ior = ior_from_f0(zz * zz * zz * zz);
+        if inv { 1.0 / ior } else { ior }
+    };
+    let e = parallel_map(n, &|z| {
+        let ior = ior_at(z);
+        let mut t = Vec::with_capacity(n * n);
+        for y in 0..n {
+            let mu = node(y, n).clamp(1e-4, 1.0);
+            for x in 0..n {
+                let rough = node(x, n).clamp(1e-4, 1.0);
+                t.push(e_glass(rough * rough, mu, ior, Q).clamp(0.0, 1.0));
             }
-            t
-        });
-        let avg = parallel_map(n, &|z| {
-            let ior = ior_at(z);
-            (0..n)
-                .map(|x| {
-                    let rough = node(x, n).clamp(1e-4, 1.0);
-                    let s: f32 = g
-                        .iter()
-                        .map(|&(mu, w)| w * 2.0 * mu * e_glass(rough * rough, mu, ior, Q_AVG))
-                        .sum();
-                    s.clamp(0.0, 1.0)
-                })
-                .collect()
-        });
-        (e, avg)
-    })
+        }
+        t
+    });
+    let avg = parallel_map(n, &|z| {
+        let ior = ior_at(z);
+        (0..n)
+            .map(|x| {
+                let rough = node(x, n).clamp(1e-4, 1.0);
+                let s: f32 = g
+                    .iter()
+                    .map(|&(mu, w)| w * 2.0 * mu * e_glass(rough * rough, mu, ior, Q_AVG))
+                    .sum();
+                s.clamp(0.0, 1.0)
+            })
+            .collect()
+    });
+    (e, avg)
+}
+
+/// Every quadrature table, in the order and lengths of `tables.bin`.
+struct Tables {
+    schlick_ior_s: Vec<f32>,
+    ggx_e: (Vec<f32>, Vec<f32>),
+    /// `[η > 1, η < 1]`.
+    ggx_glass: [(Vec<f32>, Vec<f32>); 2],
+}
+
+/// `tables.bin`: [`TABLES_MAGIC`], then the tables' f32 values, little-endian.
+static EMBEDDED: &[u8] = include_bytes!("tables.bin");
+const TABLES_MAGIC: &[u8; 16] = b"tesela-tables-1\n";
+
+impl Tables {
+    fn lengths() -> [usize; 7] {
+        let cube = N_IOR * N_IOR * N_IOR;
+        let square = N_IOR * N_IOR;
+        [cube, N_E * N_E, N_E, cube, square, cube, square]
+    }
+
+    fn compute() -> Tables {
+        Tables {
+            schlick_ior_s: compute_schlick_ior_s(),
+            ggx_e: compute_ggx_e(),
+            ggx_glass: [compute_ggx_glass(false), compute_ggx_glass(true)],
+        }
+    }
+
+    #[cfg(test)]
+    fn parts(&self) -> [&[f32]; 7] {
+        let [g, gi] = &self.ggx_glass;
+        [
+            &self.schlick_ior_s,
+            &self.ggx_e.0,
+            &self.ggx_e.1,
+            &g.0,
+            &g.1,
+            &gi.0,
+            &gi.1,
+        ]
+    }
+
+    #[cfg(test)]
+    fn encode(&self) -> Vec<u8> {
+        let mut out = TABLES_MAGIC.to_vec();
+        for part in self.parts() {
+            out.extend(part.iter().flat_map(|v| v.to_le_bytes()));
+        }
+        out
+    }
+
+    /// The tables of `bytes`, or None if they are not `encode`'s output for today's sizes.
+    fn decode(bytes: &[u8]) -> Option<Tables> {
+        let body = bytes.strip_prefix(TABLES_MAGIC)?;
+        let lengths = Tables::lengths();
+        if body.len() != 4 * lengths.iter().sum::<usize>() {
+            return None;
+        }
+        let mut values = body
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]));
+        let mut parts = lengths.map(|n| values.by_ref().take(n).collect::<Vec<f32>>());
+        let mut take = |i: usize| std::mem::take(&mut parts[i]);
+        Some(Tables {
+            schlick_ior_s: take(0),
+            ggx_e: (take(1), take(2)),
+            ggx_glass: [(take(3), take(4)), (take(5), take(6))],
+        })
+    }
+}
+
+/// The embedded tables (computed instead, should they not fit today's sizes).
+fn tables() -> &'static Tables {
+    static T: OnceLock<Tables> = OnceLock::new();
+    T.get_or_init(|| Tables::decode(EMBEDDED).unwrap_or_else(Tables::compute))
 }
 
 /// `(E(μ), E_avg)` of a white single-scattering GGX mirror with alphas `(ax, ay)` (Cycles
 /// looks up `rough = (ax·ay)^(1/4)`).
 pub fn ggx_e(alpha_x: f32, alpha_y: f32, mu: f32) -> (f32, f32) {
     let rough = (alpha_x * alpha_y).max(0.0).sqrt().sqrt();
-    let (e, avg) = ggx_e_tables();
+    let (e, avg) = &tables().ggx_e;
     (read2(e, rough, mu, N_E, N_E), read1(avg, rough, N_E))
 }
 
@@ -341,7 +413,7 @@ pub fn ggx_glass_e(alpha: f32, mu: f32, eta: f32) -> (f32, f32) {
         (false, eta)
     };
     let z = ((eta - 1.0) / (eta + 1.0)).abs().sqrt();
-    let (e, avg) = ggx_glass_tables(inv);
+    let (e, avg) = &tables().ggx_glass[inv as usize];
     (
         read3(e, rough, mu, z, N_IOR),
         read2(avg, rough, z, N_IOR, N_IOR),
@@ -401,6 +473,32 @@ pub fn fresnel_dielectric_fss(eta: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The embedded tables are this code's quadrature (within float rounding of another libm
+    /// or CPU). With `TESELA_WRITE_TABLES=1` the test writes them anew instead.
+    #[test]
+    fn embedded_tables_are_the_quadrature() {
+        let computed = Tables::compute();
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/src/bsdf/tables.bin");
+        if std::env::var_os("TESELA_WRITE_TABLES").is_some() {
+            std::fs::write(path, computed.encode()).expect("write tables.bin");
+            return;
+        }
+        let embedded = Tables::decode(EMBEDDED)
+            .expect("tables.bin does not fit today's table sizes: run with TESELA_WRITE_TABLES=1");
+        for (i, (a, b)) in computed.parts().iter().zip(embedded.parts()).enumerate() {
+            assert_eq!(a.len(), b.len());
+            for (k, (x, y)) in a.iter().zip(b).enumerate() {
+                assert!(
+                    (x - y).abs() <= 1e-6,
+                    "table {i} entry {k}: quadrature {x}, embedded {y} (regenerate with \
+                     TESELA_WRITE_TABLES=1 if the definition changed)"
+                );
+            }
+        }
+        assert!(Tables::decode(&EMBEDDED[1..]).is_none());
+        assert!(Tables::decode(&EMBEDDED[..EMBEDDED.len() - 4]).is_none());
+    }
 
     #[test]
     fn lookup_interpolates_like_cycles() {
