@@ -564,6 +564,9 @@ ADDON_SCENES = {
     # A diffuse and a glossy sphere on a plane under an HDRI world with a small bright sun, the
     # sky behind them (tests/blender/test_world_cycles.py: hdri_world).
     "hdri_product": ("test_world_cycles", "hdri_world"),
+    # A room lit by a sun through a window, a ceiling area light and a dim sky: planks (image),
+    # noise roughness, normal and bump maps, a Brick rug, textured metal (bench/interior.py).
+    "interior": ("interior", "textured_interior"),
 }
 
 
@@ -682,6 +685,7 @@ def _render_result_image():
 CLEAN_SCENES = {
     "cornell": ("scenes", "cornell_box"),
     "hdri_product": ("test_world_cycles", "hdri_world"),
+    "interior": ("interior", "textured_interior"),
 }
 
 
@@ -701,7 +705,8 @@ def clean_bench(args):
              f"path_mis depth {bounces + 2}, {args.threads} threads; relMSE against each "
              f"renderer's own {ref_spp} spp reference", "",
              "| scene | peer | settings | wall s | relMSE | mean RGB |", "| --- | --- | --- | --- | --- | --- |"]
-    for name, (module, builder) in CLEAN_SCENES.items():
+    for name in [n.strip() for n in args.clean_scenes.split(",") if n.strip()]:
+        module, builder = CLEAN_SCENES[name]
         bs.clear_scene()
         getattr(importlib.import_module(module), builder)()
         sc = bpy.context.scene
@@ -835,6 +840,7 @@ def main():
     ap.add_argument("--clean", action="store_true",
                     help="time to a clean image with each renderer's defaults (adaptive + OIDN)")
     ap.add_argument("--clean-ref-spp", type=int, default=2048)
+    ap.add_argument("--clean-scenes", default=",".join(CLEAN_SCENES))
     ap.add_argument("--equal-time", action="store_true",
                     help="Blender scenes through the add-on: relMSE at Cycles' wall time, plain MC")
     args = ap.parse_args()
