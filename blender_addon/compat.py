@@ -422,23 +422,16 @@ def light_uses_mis(light):
 
 def ray_visibility(obj):
     """The object's ray visibility, Object > Visibility > Ray Visibility:
-    {"camera", "diffuse", "glossy", "transmission"} (3.0+ `visible_*`, before `cycles_visibility`)."""
+    {"camera", "diffuse", "glossy", "transmission", "shadow"} (3.0+ `visible_*`, before
+    `cycles_visibility`)."""
     out = {}
     cv = getattr(obj, "cycles_visibility", None)
-    for key in ("camera", "diffuse", "glossy", "transmission"):
+    for key in ("camera", "diffuse", "glossy", "transmission", "shadow"):
         v = getattr(obj, "visible_" + key, None)
         if v is None:
             v = getattr(cv, key, True) if cv is not None else True
         out[key] = bool(v)
     return out
-
-
-def visible_camera(obj):
-    v = getattr(obj, "visible_camera", None)
-    if v is not None:
-        return bool(v)
-    cv = getattr(obj, "cycles_visibility", None)  # pre-3.0
-    return bool(getattr(cv, "camera", True)) if cv is not None else True
 
 
 def is_extension_platform():

@@ -13,7 +13,7 @@ use crate::frame::Frame;
 use crate::instancing::InstanceAccel;
 use crate::integrator::MAX_TRANSPARENT;
 use crate::integrator::mis_weight;
-use crate::scene::{Light, Scene};
+use crate::scene::{Light, ObjectInfo, Scene};
 use crate::scene::{LightShape, LightVisibility};
 use crate::shading::globals::ray;
 use crate::shading::globals::{ShadeEnv, ShaderGlobals, to_blender};
@@ -245,6 +245,9 @@ pub struct RenderScene {
     pub programs: Vec<Arc<Program>>,
     /// Some material may be transparent: shadow rays and last path segments look through.
     passes: bool,
+    /// The ray kinds (Light Path bits) some object is hidden from ([`ObjectInfo::visibility`]):
+    /// rays of those kinds step over such objects' surfaces.
+    hides: u32,
     /// The camera in Blender's coordinates, for the graph's Camera coordinates.
     camera_to_world: Mat4,
     /// The world-space meshes.
@@ -294,6 +297,32 @@ fn compile_programs(scene: &Scene) -> (Vec<Arc<Program>>, Vec<String>) {
     (programs, warnings)
 }
 
+/// The ray kinds some world-space mesh or instance is hidden from.
+fn hidden_rays(scene: &Scene) -> u32 {
+    let meshes = scene.meshes.iter().map(|m| m.attrs.object.visibility);
+    let instances = scene.instances.iter().map(|i| i.object.visibility);
+    meshes
+        .chain(instances)
+        .fold(0, |h, v| h | (ObjectInfo::VISIBLE_TO_ALL & !v))
+}
+
+/// What a ray scattered with the Light Path bits `flags` sees objects as (Cycles'
+/// `path_state_ray_visibility`: transmission rays are only that; reflected ones diffuse or
+/// glossy); every kind but shadow when `flags` says nothing of a bounce.
+#[inline]
+fn bounce_visibility(flags: u32) -> u32 {
+    if flags & ray::TRANSMISSION != 0 {
+        return ray::TRANSMISSION;
+    }
+    match flags & (ray::DIFFUSE | ray::GLOSSY) {
+        0 => ObjectInfo::VISIBLE_TO_ALL & !ray::SHADOW,
+        kind => kind,
+    }
+}
+
+/// Most surfaces of hidden objects one ray steps over.
+const MAX_HIDDEN_SKIPS: usize = 64;
+
 /// The camera in Blender's coordinates (for the graph's Camera coordinates).
 fn blender_camera_to_world(scene: &Scene) -> Mat4 {
     scene.camera.map_or(Mat4::IDENTITY, |c| {
@@ -335,6 +364,7 @@ impl LightParts {
         let placed = scene.placed_meshes();
         let mut emitters = Vec::new();
         let mut mesh_emitter = vec![None; scene.meshes.len()];
+        let mut visibility = Vec::new();
         for (mi, m) in scene.meshes.iter().enumerate() {
             let program = &programs[m.material];
             // Placed meshes emit through their baked copies; a mesh emptied by the baking
@@ -346,6 +376,15 @@ impl LightParts {
                 Some(e) => {
                     mesh_emitter[mi] = Some(emitters.len() as u32);
                     emitters.push(EmitterInstance::Area(e.with_camera(camera_to_world)));
+                    // An object hidden from a closure's rays does not light it by emitter
+                    // sampling either (Cycles' SHADER_EXCLUDE_* of mesh lights).
+                    let v = m.attrs.object.visibility;
+                    visibility.push(LightVisibility {
+                        diffuse: v & ray::DIFFUSE != 0,
+                        glossy: v & ray::GLOSSY != 0,
+                        transmission: v & ray::TRANSMISSION != 0,
+                        ..LightVisibility::default()
+                    });
                 }
                 None => warnings.push(format!(
                     "emissive mesh `{}` has zero area; it does not light the scene",
@@ -353,7 +392,6 @@ impl LightParts {
                 )),
             }
         }
-        let mut visibility = vec![LightVisibility::default(); emitters.len()];
         for l in &scene.lights {
             visibility.push(match l {
                 Light::Blender { visibility, .. } => *visibility,
@@ -457,9 +495,11 @@ impl RenderScene {
         );
         scene.warnings.extend(warnings);
         let passes = programs.iter().any(|p| p.may_pass());
+        let hides = hidden_rays(&scene);
         RenderScene {
             scene,
             passes,
+            hides,
             programs,
             camera_to_world,
             accel,
@@ -520,6 +560,7 @@ impl RenderScene {
         let (programs, mut warnings) = compile_programs(&self.scene);
         self.programs = programs;
         self.passes = self.programs.iter().any(|p| p.may_pass());
+        self.hides = hidden_rays(&self.scene);
         warnings.extend(self.refresh_lights());
         warnings
     }
@@ -744,8 +785,54 @@ impl RenderScene {
     #[inline]
     pub fn intersect(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Option<Intersection> {
         ctx.cast(o, d, f32::INFINITY, RayKind::Closest);
-        let hit = self.closest(ctx, o, d, f32::INFINITY)?;
+        let hit = if self.hides & !(ray::CAMERA | ray::SHADOW) == 0 {
+            self.closest(ctx, o, d, f32::INFINITY)?
+        } else {
+            let kind = bounce_visibility(ctx.ray_flags);
+            self.closest_seen(ctx, o, d, f32::INFINITY, kind)?
+        };
         Some(self.intersection(&hit, d))
+    }
+
+    /// Whether rays of the kinds `kind` (Light Path bits) see the object of `hit`.
+    #[inline]
+    fn sees(&self, hit: &Hit, kind: u32) -> bool {
+        self.object_visibility(hit.key[0], hit.instance) & kind != 0
+    }
+
+    /// [`ObjectInfo::visibility`] of world-space mesh `mesh`, or of `instance` when it is one.
+    #[inline]
+    fn object_visibility(&self, mesh: u32, instance: u32) -> u32 {
+        if instance == NO_INSTANCE {
+            self.scene.meshes[mesh as usize].attrs.object.visibility
+        } else {
+            self.scene.instances[instance as usize].object.visibility
+        }
+    }
+
+    /// [`Self::closest`] among the objects rays of the kinds `kind` see: the surfaces of
+    /// others are stepped over (up to [`MAX_HIDDEN_SKIPS`]; `t` stays measured from `o`).
+    #[inline(never)]
+    fn closest_seen(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32, kind: u32) -> Option<Hit> {
+        let mut tmin = 0.0;
+        for _ in 0..MAX_HIDDEN_SKIPS {
+            let hit = self.closest_after(ctx, o, d, tmin, tmax)?;
+            if self.sees(&hit, kind) {
+                return Some(hit);
+            }
+            tmin = hit.t;
+        }
+        None
+    }
+
+    /// The closest surface that casts shadows in `(0, tmax)`.
+    #[inline]
+    fn closest_shadowing(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32) -> Option<Hit> {
+        if self.hides & ray::SHADOW == 0 {
+            self.closest(ctx, o, d, tmax)
+        } else {
+            self.closest_seen(ctx, o, d, tmax, ray::SHADOW)
+        }
     }
 
     /// The closest hit in `(0, tmax)` over the world-space meshes and the instances.
@@ -861,7 +948,7 @@ impl RenderScene {
     /// background costs no scene traversal at all. Not for camera rays (hidden meshes).
     #[inline]
     pub fn emission_along(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Emitted {
-        if self.passes {
+        if self.passes || self.hides != 0 {
             return self.emission_through(ctx, o, d);
         }
         let Some(emissive) = &self.emitter_accel else {
@@ -942,7 +1029,7 @@ impl RenderScene {
         ng: Vec3,
         rec: &EmitterQueryRecord,
     ) -> Vec3 {
-        if !self.passes {
+        if !self.passes && self.hides & ray::SHADOW == 0 {
             return if self.unoccluded(ctx, p, ng, rec) {
                 Vec3::ONE
             } else {
@@ -967,7 +1054,7 @@ impl RenderScene {
     /// The transmittance of the segment `o + t d`, `t ∈ (0, tmax)`: 1 or 0 in opaque scenes,
     /// the product of the transparent surfaces' transmittance otherwise.
     fn segment_transmittance(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32) -> Vec3 {
-        if !self.passes {
+        if !self.passes && self.hides & ray::SHADOW == 0 {
             ctx.cast(o, d, tmax, RayKind::Any);
             return if self.occluded(ctx, o, d, tmax) {
                 Vec3::ZERO
@@ -979,7 +1066,7 @@ impl RenderScene {
         let mut tr = Vec3::ONE;
         for _ in 0..=MAX_TRANSPARENT {
             ctx.cast(o, d, tmax, RayKind::Closest);
-            let Some(hit) = self.closest(ctx, o, d, tmax) else {
+            let Some(hit) = self.closest_shadowing(ctx, o, d, tmax) else {
                 return tr;
             };
             let its = self.intersection(&hit, d);
@@ -1051,14 +1138,22 @@ impl RenderScene {
             return self.intersect(ctx, o, d);
         }
         let mut its = self.intersect_before(ctx, o, d, ctx.camera_tmax(o, d))?;
-        for _ in 0..64 {
-            if !self.scene.meshes[its.mesh as usize].hidden_from_camera {
+        for _ in 0..MAX_HIDDEN_SKIPS {
+            let hidden = self.scene.meshes[its.mesh as usize].hidden_from_camera
+                || (self.hides & ray::CAMERA != 0 && !self.its_seen(&its, ray::CAMERA));
+            if !hidden {
                 return Some(its);
             }
             let o = offset_origin(its.p, its.ng, d);
             its = self.intersect_before(ctx, o, d, ctx.camera_tmax(o, d))?;
         }
         Some(its)
+    }
+
+    /// Whether rays of the kinds `kind` see the object of `its`.
+    #[inline]
+    fn its_seen(&self, its: &Intersection, kind: u32) -> bool {
+        self.object_visibility(its.mesh, its.instance) & kind != 0
     }
 
     /// Closest surface along the unit direction `d` from `o` nearer than `tmax`.

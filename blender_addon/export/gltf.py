@@ -236,8 +236,11 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             cached = object_mesh(obj)
             if cached is None:
                 continue
-            if not compat.visible_camera(obj):
-                warnings.append("object '%s' is hidden from the camera; Tesela renders it anyway" % obj.name)
+            for flag, what in (("is_shadow_catcher", "a shadow catcher"),
+                               ("is_holdout", "a holdout")):
+                if getattr(obj, flag, False):
+                    warnings.append("object '%s' is %s; Tesela renders it as an ordinary "
+                                    "object" % (obj.name, what))
             mi, ntri, texspace = cached
             res.triangles += ntri
             extras = {"tesela_object": object_extras(inst, obj)}

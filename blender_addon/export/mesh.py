@@ -434,7 +434,15 @@ def object_extras(inst, obj):
     """extras.tesela_object: what Object Info reads (Blender's world coordinates)."""
     rid = random_id(inst, obj)
     m = inst.matrix_world
-    return {"random": random_number(rid), "random_id": rid,
-            "pass_index": int(getattr(obj, "pass_index", 0)),
-            "color": [float(v) for v in getattr(obj, "color", (1.0, 1.0, 1.0, 1.0))],
-            "location": [float(m[0][3]), float(m[1][3]), float(m[2][3])]}
+    out = {"random": random_number(rid), "random_id": rid,
+           "pass_index": int(getattr(obj, "pass_index", 0)),
+           "color": [float(v) for v in getattr(obj, "color", (1.0, 1.0, 1.0, 1.0))],
+           "location": [float(m[0][3]), float(m[1][3]), float(m[2][3])]}
+    # An instance is hidden from the rays its object or its instancer is hidden from.
+    vis = compat.ray_visibility(obj)
+    if inst.is_instance and inst.parent is not None:
+        parent = compat.ray_visibility(inst.parent)
+        vis = {k: v and parent[k] for k, v in vis.items()}
+    if not all(vis.values()):
+        out["visibility"] = vis
+    return out

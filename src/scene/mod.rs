@@ -53,6 +53,20 @@ pub struct ObjectInfo {
     pub color: glam::Vec4,
     /// Object origin, renderer world space.
     pub location: Vec3,
+    /// The kinds of rays that see the object (Blender's Object > Visibility > Ray Visibility),
+    /// as Light Path bits of [`crate::shading::globals::ray`]: `CAMERA`, `DIFFUSE`, `GLOSSY`,
+    /// `TRANSMISSION` for the rays scattered by those closures, and `SHADOW` for shadow rays
+    /// (off: it casts no shadow). Rays of other kinds pass through it, as in Cycles.
+    pub visibility: u32,
+}
+
+impl ObjectInfo {
+    /// Every kind of ray sees the object.
+    pub const VISIBLE_TO_ALL: u32 = crate::shading::globals::ray::CAMERA
+        | crate::shading::globals::ray::SHADOW
+        | crate::shading::globals::ray::DIFFUSE
+        | crate::shading::globals::ray::GLOSSY
+        | crate::shading::globals::ray::TRANSMISSION;
 }
 
 impl Default for ObjectInfo {
@@ -62,6 +76,7 @@ impl Default for ObjectInfo {
             pass_index: 0.0,
             color: glam::Vec4::ONE,
             location: Vec3::ZERO,
+            visibility: ObjectInfo::VISIBLE_TO_ALL,
         }
     }
 }

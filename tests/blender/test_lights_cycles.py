@@ -228,6 +228,12 @@ CASES = [
 
 @pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
 def test_light_parameters_agree_with_cycles(addon, tesela_bin, tmp_path, monkeypatch, case):  # noqa: F811
+    agrees_with_cycles(tesela_bin, tmp_path, monkeypatch, case)
+
+
+def agrees_with_cycles(tesela_bin, tmp_path, monkeypatch, case):
+    """Renders case (id, builder, Cycles max_bounces, Tesela integrator, spp) with Cycles and
+    through the add-on, and asserts they agree: means and 8x8 blocks, edges locally."""
     name, build, bounces, integrator, spp = case
     monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
     info = build()

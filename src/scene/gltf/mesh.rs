@@ -433,6 +433,13 @@ impl<'a> Loader<'a> {
                 None => bad.push("location"),
             },
         }
+        match member(o, "visibility") {
+            None => {}
+            Some(v) => match visibility_bits(v) {
+                Some(bits) => info.visibility = bits,
+                None => bad.push("visibility"),
+            },
+        }
         if !bad.is_empty() {
             self.warn_once(format!(
                 "node {ni}: extras.tesela_object has an invalid {}; defaults are used for it",
@@ -817,6 +824,29 @@ impl<'a> Loader<'a> {
         }
         Ok(Some(local))
     }
+}
+
+/// `extras.tesela_object.visibility` (`{"camera": bool, "shadow": bool, "diffuse": bool,
+/// "glossy": bool, "transmission": bool}`, a missing member is true) as
+/// [`ObjectInfo::visibility`] bits; None unless it is an object of booleans.
+fn visibility_bits(v: &Value) -> Option<u32> {
+    use crate::shading::globals::ray;
+    let o = v.as_object()?;
+    let mut bits = ObjectInfo::VISIBLE_TO_ALL;
+    for (name, bit) in [
+        ("camera", ray::CAMERA),
+        ("shadow", ray::SHADOW),
+        ("diffuse", ray::DIFFUSE),
+        ("glossy", ray::GLOSSY),
+        ("transmission", ray::TRANSMISSION),
+    ] {
+        if let Some(b) = o.get(name)
+            && !b.as_bool()?
+        {
+            bits &= !bit;
+        }
+    }
+    Some(bits)
 }
 
 #[cfg(test)]

@@ -630,6 +630,38 @@ fn object_space_texture_space_and_object_info() {
 }
 
 #[test]
+fn object_ray_visibility_from_the_extras() {
+    use crate::scene::ObjectInfo;
+    use crate::shading::globals::ray;
+    let s = load(&quad_doc(json!({}), json!({}), &[], json!({})));
+    assert_eq!(
+        s.meshes[0].attrs.object.visibility,
+        ObjectInfo::VISIBLE_TO_ALL
+    );
+    let node = json!({ "extras": { "tesela_object": {
+        "visibility": { "camera": false, "shadow": false, "glossy": true } } } });
+    let s = load(&quad_doc(json!({}), json!({}), &[], node));
+    assert_eq!(
+        s.meshes[0].attrs.object.visibility,
+        ray::DIFFUSE | ray::GLOSSY | ray::TRANSMISSION
+    );
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    for bad in [json!({ "camera": 0 }), json!([false]), json!("none")] {
+        let node = json!({ "extras": { "tesela_object": { "visibility": bad } } });
+        let s = load(&quad_doc(json!({}), json!({}), &[], node));
+        assert_eq!(
+            s.meshes[0].attrs.object.visibility,
+            ObjectInfo::VISIBLE_TO_ALL
+        );
+        assert!(
+            s.warnings.iter().any(|w| w.contains("invalid visibility")),
+            "{:?}",
+            s.warnings
+        );
+    }
+}
+
+#[test]
 fn blender_auto_texture_space_rules() {
     use super::mesh::auto_texspace;
     let (l, s) = auto_texspace(Vec3::new(-1.0, 0.0, 2.0), Vec3::new(3.0, 0.0, 2.000001));
