@@ -427,7 +427,8 @@ fn light_sampler_power_and_uniform_choice() {
             0.0,
             2.0 * PI * (1.0 - 0.7) * lum(Vec3::new(30.0, 20.0, 10.0)),
             lum(Vec3::splat(3.0)) * PI * r * r,
-            lum(Vec3::new(0.2, 0.3, 0.4)) * 4.0 * PI * PI * r * r,
+            // A world counts the irradiance π L of a facing surface, as a sun counts E.
+            lum(Vec3::new(0.2, 0.3, 0.4)) * PI * PI * r * r,
         ];
         let powers: Vec<f64> = rs
             .emitters

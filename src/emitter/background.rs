@@ -28,8 +28,10 @@ impl Emitter for Background {
         square_to_uniform_sphere_pdf()
     }
 
+    /// The irradiance `π L` of a facing surface over the cross-section `π r²` (as
+    /// [`super::environment::Environment`]'s).
     fn power(&self, _scene: &Scene, r: f32) -> f32 {
-        luminance(self.radiance) * 4.0 * PI * PI * r * r
+        luminance(self.radiance) * PI * PI * r * r
     }
 
     fn is_delta(&self) -> bool {

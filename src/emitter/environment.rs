@@ -251,6 +251,8 @@ pub struct Environment {
     dist: Option<Box<Distribution2D>>,
     /// `∫ luminance dω` over the sphere, for light selection (0: not a light).
     integral: f32,
+    /// The part of `integral` that is a guided sun's irradiance.
+    sun_integral: f32,
     /// A sky's sun sampled apart (Cycles' sun guiding): the map leaves its disc out and
     /// [`SUN_FRACTION`] of the samples are drawn uniformly in its cone.
     sun: Option<SunCone>,
@@ -311,6 +313,7 @@ impl Environment {
             camera_to_world,
             dist: None,
             integral: 0.0,
+            sun_integral: 0.0,
             sun: None,
         };
         let Some([w, h, ss]) = res else {
@@ -368,7 +371,8 @@ impl Environment {
         let first = lum[0];
         if let Some(s) = &guided {
             env.sun = Some(SunCone::new(s));
-            env.integral += luminance(s.power);
+            env.sun_integral = luminance(s.power);
+            env.integral += env.sun_integral;
         }
         if lum.iter().all(|&l| l == first) && env.sun.is_none() {
             env.integral = if first.is_finite() {
@@ -394,6 +398,7 @@ impl Environment {
         env.dist = Distribution2D::new(w, h, func).map(Box::new);
         if env.dist.is_none() && env.sun.is_none() {
             env.integral = 0.0;
+            env.sun_integral = 0.0;
         }
         env
     }
@@ -488,8 +493,14 @@ impl Emitter for Environment {
         self.pdf_dir(rec.wi)
     }
 
+    /// What the world delivers to the scene's cross-section `π r²` as a surface facing it
+    /// receives it: the irradiance `∫ L cos θ dω` over a hemisphere, which is `∫ L dω / 4` for
+    /// a sky of no preferred direction (Cycles' `π · average radiance`), plus a guided sun's
+    /// irradiance in full. Against the suns' `E π r²`, the flux through the sphere `∫ L dω π r²`
+    /// would choose a world four times as often as its light is worth where it arrives.
     fn power(&self, _scene: &Scene, r: f32) -> f32 {
-        self.integral * PI * r * r
+        let sky = (self.integral - self.sun_integral).max(0.0);
+        (0.25 * sky + self.sun_integral) * PI * r * r
     }
 
     fn is_delta(&self) -> bool {
