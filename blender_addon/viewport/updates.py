@@ -8,7 +8,7 @@ the change cannot be expressed as one (an object added, an instancer moved, a te
 
 import bpy
 
-from .. import export
+from .. import compat, export
 from ..export.common import gltf_matrix, matrix
 from ..export.mesh import MESHLIKE
 
@@ -35,6 +35,7 @@ class SceneIndex:
         self.objects = {}        # object name -> original object pointer (identity)
         self.instancers = set()  # objects whose instances the export placed
         self.light_users = {}    # light datablock name -> object names
+        self.ray_visibility = {}  # object name -> its Ray Visibility flags as exported
         for inst in depsgraph.object_instances:
             if inst.is_instance:
                 par = _original(inst.parent)
@@ -45,11 +46,17 @@ class SceneIndex:
             if obj.type not in EXPORTED_TYPES:
                 continue
             self.objects[obj.name] = _original(obj).as_pointer()
+            self.ray_visibility[obj.name] = ray_visibility_key(obj)
             if obj.type == "LIGHT":
                 self.light_users.setdefault(obj.data.name, []).append(obj.name)
         self.visible = {name: True for name in self.objects}
         scene = depsgraph.scene
         self.world = scene.world.name if scene.world is not None else None
+
+
+def ray_visibility_key(obj):
+    """An object's Ray Visibility flags, comparable between updates."""
+    return tuple(sorted(compat.ray_visibility(obj).items()))
 
 
 def present_objects(depsgraph):
@@ -143,6 +150,14 @@ def translate(depsgraph, index, write_mesh, scratch_dir):
                 if u.is_updated_transform or u.is_updated_geometry:
                     out.need_load("instanced object '%s' changed" % name)
                 continue
+            vis = ray_visibility_key(idb)
+            if vis != index.ray_visibility.get(name, vis):
+                index.ray_visibility[name] = vis
+                if idb.type == "LIGHT":
+                    lights[name] = idb
+                else:
+                    out.need_load("object '%s' ray visibility changed" % name)
+                    continue
             # Hiding and showing an object re-evaluates it: that is no new geometry.
             if u.is_updated_geometry and index.visible[name]:
                 if idb.type == "LIGHT":

@@ -438,6 +438,23 @@ def test_hide_and_show_send_visibility_only(recorder):
     assert recorder.meshes == []
 
 
+def test_ray_visibility_edits_reach_the_session(recorder):
+    # An object's Ray Visibility is in its glTF node: a load; a light's travels in its fields.
+    cube = bpy.data.objects["Cube"]
+    try:
+        load, _ = recorder.run(lambda: setattr(cube, "visible_shadow", False))
+        assert load and "ray visibility" in next(r.reason for r in recorder.results if r.load)
+    finally:
+        recorder.run(lambda: setattr(cube, "visible_shadow", True))
+    lamp = bpy.data.objects["Lamp"]
+    try:
+        load, cmds = recorder.run(lambda: setattr(lamp, "visible_diffuse", False))
+        assert not load and names(cmds) == [("light", "Lamp")]
+        assert cmds[0][1]["light"]["visible_diffuse"] is False
+    finally:
+        recorder.run(lambda: setattr(lamp, "visible_diffuse", True))
+
+
 def test_world_edit_sends_world(recorder):
     scene = bpy.context.scene
     if scene.world is None:
