@@ -36,7 +36,7 @@ def _planks_px(w=128, h=128, planks=8):
 
 
 def textured_interior():
-    x0, x1, y0, y1, h = -2.0, 2.0, -2.0, 2.0, 2.6
+    x0, x1, y0, y1 = -2.0, 2.0, -2.0, 2.0
 
     # Floor: planks, noise roughness, normal map.
     mat, nt, out = node_material("Planks")
@@ -56,15 +56,7 @@ def textured_interior():
     # Walls and ceiling.
     wall, nt, out = node_material("Wall")
     principled(nt, out, Base_Color=(0.75, 0.72, 0.66, 1.0), Roughness=0.7)
-    scenes.add_quad("Ceiling", [(x0, y0, h), (x0, y1, h), (x1, y1, h), (x1, y0, h)], wall)
-    scenes.add_quad("Back", [(x0, y1, 0), (x1, y1, 0), (x1, y1, h), (x0, y1, h)], wall)
-    scenes.add_quad("Left", [(x0, y0, 0), (x0, y1, 0), (x0, y1, h), (x0, y0, h)], wall)
-    scenes.add_quad("Right", [(x1, y0, 0), (x1, y0, h), (x1, y1, h), (x1, y1, 0)], wall)
-    wx, wz0, wz1 = 0.7, 1.0, 2.0
-    front = [[(x0, 0), (-wx, 0), (-wx, h), (x0, h)], [(wx, 0), (x1, 0), (x1, h), (wx, h)],
-             [(-wx, 0), (wx, 0), (wx, wz0), (-wx, wz0)], [(-wx, wz1), (wx, wz1), (wx, h), (-wx, h)]]
-    for i, q in enumerate(front):
-        scenes.add_quad(f"Front{i}", [(x, y0, z) for x, z in q][::-1], wall)
+    scenes.add_room(wall)
 
     # Rug: Brick texture colour and bump.
     rug, nt, out = node_material("Rug")

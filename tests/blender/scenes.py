@@ -183,6 +183,26 @@ def add_box(name, lo, hi, mat=None):
     return add_mesh(name, v, f, mat)
 
 
+def add_room(walls, floor=None, size=(4.0, 4.0, 2.6), window=(1.4, 1.0, 2.0)):
+    """A closed room centred on the origin, floor at z = 0 (material `floor`, or none: the
+    caller lays its own), ceiling and walls of material `walls`; the -y wall has a window
+    `window = (width, bottom, top)` (metres) centred in x."""
+    sx, sy, h = size
+    x0, x1, y0, y1 = -sx / 2, sx / 2, -sy / 2, sy / 2
+    if floor is not None:
+        add_quad("Floor", [(x0, y0, 0), (x1, y0, 0), (x1, y1, 0), (x0, y1, 0)], floor)
+    add_quad("Ceiling", [(x0, y0, h), (x0, y1, h), (x1, y1, h), (x1, y0, h)], walls)
+    add_quad("Back", [(x0, y1, 0), (x1, y1, 0), (x1, y1, h), (x0, y1, h)], walls)
+    add_quad("Left", [(x0, y0, 0), (x0, y1, 0), (x0, y1, h), (x0, y0, h)], walls)
+    add_quad("Right", [(x1, y0, 0), (x1, y0, h), (x1, y1, h), (x1, y1, 0)], walls)
+    # The front wall (y = y0, facing +y) around the window.
+    wx, wz0, wz1 = window[0] / 2, window[1], window[2]
+    front = [[(x0, 0), (-wx, 0), (-wx, h), (x0, h)], [(wx, 0), (x1, 0), (x1, h), (wx, h)],
+             [(-wx, 0), (wx, 0), (wx, wz0), (-wx, wz0)], [(-wx, wz1), (wx, wz1), (wx, h), (-wx, h)]]
+    for i, q in enumerate(front):
+        add_quad(f"Front{i}", [(x, y0, z) for x, z in q][::-1], walls)
+
+
 def add_sphere(name, center, radius, mat=None, segments=48, rings=24, smooth=True):
     """A UV sphere with outward normals."""
     bm = bmesh.new()

@@ -188,18 +188,8 @@ def sunlit_room():
     occlude, so the sun's patch on the floor has no dark blotch under the area light."""
     scene = scenes.clear_scene()
     white = scenes.lambert("White", (0.7, 0.7, 0.7))
-    x0, x1, y0, y1, h = -2.0, 2.0, -2.0, 2.0, 2.6
-    scenes.add_quad("Floor", [(x0, y0, 0), (x1, y0, 0), (x1, y1, 0), (x0, y1, 0)], white)
-    scenes.add_quad("Ceiling", [(x0, y0, h), (x0, y1, h), (x1, y1, h), (x1, y0, h)], white)
-    scenes.add_quad("Back", [(x0, y1, 0), (x1, y1, 0), (x1, y1, h), (x0, y1, h)], white)
-    scenes.add_quad("Left", [(x0, y0, 0), (x0, y1, 0), (x0, y1, h), (x0, y0, h)], white)
-    scenes.add_quad("Right", [(x1, y0, 0), (x1, y0, h), (x1, y1, h), (x1, y1, 0)], white)
-    # The front wall (y = y0, facing +y) with a 1.4 x 1 m window from z = 1.0 to 2.0.
-    wx, wz0, wz1 = 0.7, 1.0, 2.0
-    front = [[(x0, 0), (-wx, 0), (-wx, h), (x0, h)], [(wx, 0), (x1, 0), (x1, h), (wx, h)],
-             [(-wx, 0), (wx, 0), (wx, wz0), (-wx, wz0)], [(-wx, wz1), (wx, wz1), (wx, h), (-wx, h)]]
-    for i, q in enumerate(front):
-        scenes.add_quad(f"Front{i}", [(x, y0, z) for x, z in q][::-1], white)
+    # A 1.4 x 1 m window from z = 1.0 to 2.0.
+    scenes.add_room(white, white)
     scenes.add_sun_light("Sun", (0.0, 1.0, -0.8), 6.0, angle=math.radians(3.0))
     a = scenes.add_area_light("Fill", (0.0, -0.9, 0.9), (0.0, -0.9, 0.0), 40.0, 0.6)
     a.visible_camera = False
