@@ -1130,40 +1130,21 @@ impl RenderScene {
     }
 
     /// Like [`RenderScene::intersect`] for the ray leaving path vertex `depth - 1`; camera rays
-    /// (`depth == 1`) pass through meshes hidden from the camera and end at the camera's far
-    /// clip ([`Ctx::camera_end`]).
+    /// (`depth == 1`) see the objects visible to the camera, whatever Light Path bits the
+    /// context holds from an earlier path, and end at the camera's far clip
+    /// ([`Ctx::camera_end`]).
     #[inline]
     pub fn trace(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, depth: u32) -> Option<Intersection> {
         if depth != 1 {
             return self.intersect(ctx, o, d);
         }
-        let mut its = self.intersect_before(ctx, o, d, ctx.camera_tmax(o, d))?;
-        for _ in 0..MAX_HIDDEN_SKIPS {
-            let hidden = self.scene.meshes[its.mesh as usize].hidden_from_camera
-                || (self.hides & ray::CAMERA != 0 && !self.its_seen(&its, ray::CAMERA));
-            if !hidden {
-                return Some(its);
-            }
-            let o = offset_origin(its.p, its.ng, d);
-            its = self.intersect_before(ctx, o, d, ctx.camera_tmax(o, d))?;
-        }
-        Some(its)
-    }
-
-    /// Whether rays of the kinds `kind` see the object of `its`.
-    #[inline]
-    fn its_seen(&self, its: &Intersection, kind: u32) -> bool {
-        self.object_visibility(its.mesh, its.instance) & kind != 0
-    }
-
-    /// Closest surface along the unit direction `d` from `o` nearer than `tmax`.
-    #[inline]
-    fn intersect_before(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32) -> Option<Intersection> {
-        if tmax == f32::INFINITY {
-            return self.intersect(ctx, o, d);
-        }
+        let tmax = ctx.camera_tmax(o, d);
         ctx.cast(o, d, tmax, RayKind::Closest);
-        let hit = self.closest(ctx, o, d, tmax)?;
+        let hit = if self.hides & ray::CAMERA == 0 {
+            self.closest(ctx, o, d, tmax)?
+        } else {
+            self.closest_seen(ctx, o, d, tmax, ray::CAMERA)?
+        };
         Some(self.intersection(&hit, d))
     }
 
@@ -1591,6 +1572,41 @@ mod tests {
         }
         ctx.camera_end = None;
         assert!(rs.trace(&mut ctx, o, d, 1).is_some());
+    }
+
+    /// Camera rays see what the camera sees whatever bits an earlier path left in the context,
+    /// and bounce rays what their kind sees, with and without a far clip.
+    #[test]
+    fn camera_and_bounce_rays_see_by_their_own_kind() {
+        let mut rs = RenderScene::new(builtin::by_name("cornell-box").unwrap(), LightChoice::Power);
+        let mut ctx = Ctx::new(SobolSampler::new(0, 0, 0));
+        let (o, d) = (Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.0, 0.0, -1.0));
+        let wall = rs.intersect(&mut ctx, o, d).expect("the back wall");
+        let seen = |rs: &RenderScene, ctx: &mut Ctx, depth| {
+            rs.trace(ctx, o, d, depth)
+                .is_some_and(|h| h.mesh == wall.mesh)
+        };
+        let bounce = ray::DIFFUSE | ray::REFLECTION;
+        for end in [None, Some(o + d * (2.0 * wall.t))] {
+            ctx.camera_end = end;
+            rs.scene.meshes[wall.mesh as usize].attrs.object.visibility =
+                ObjectInfo::VISIBLE_TO_ALL & !ray::DIFFUSE;
+            rs.refresh_shading();
+            ctx.ray_flags = bounce; // left by the previous sample's last bounce
+            assert!(
+                seen(&rs, &mut ctx, 1),
+                "the camera sees a wall hidden from diffuse rays"
+            );
+            assert!(!seen(&rs, &mut ctx, 2), "diffuse rays pass through it");
+            rs.scene.meshes[wall.mesh as usize].attrs.object.visibility =
+                ObjectInfo::VISIBLE_TO_ALL & !ray::CAMERA;
+            rs.refresh_shading();
+            assert!(
+                !seen(&rs, &mut ctx, 1),
+                "camera rays pass through a camera-hidden wall"
+            );
+            assert!(seen(&rs, &mut ctx, 2), "diffuse rays see it");
+        }
     }
 
     /// An emissive graph that reads the viewing direction and the side it is seen from

@@ -763,7 +763,6 @@ fn mesh(name: &str, material: usize, positions: Vec<Vec3>, normals: Vec<Vec3>) -
         normals,
         uvs: Vec::new(),
         material,
-        hidden_from_camera: false,
         attrs: Default::default(),
     }
 }

@@ -38,7 +38,6 @@ pub fn quad(name: &str, material: usize, a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> 
         ],
         indices: vec![[0, 1, 2], [0, 2, 3]],
         material,
-        hidden_from_camera: false,
         attrs: Default::default(),
     }
 }

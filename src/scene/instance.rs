@@ -102,7 +102,6 @@ impl Mesh {
                 self.indices.clone()
             },
             material: inst.material.unwrap_or(self.material),
-            hidden_from_camera: self.hidden_from_camera,
             attrs,
         }
     }

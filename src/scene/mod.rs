@@ -37,9 +37,6 @@ pub struct Mesh {
     pub indices: Vec<[u32; 3]>,
     /// Index into [`Scene::materials`].
     pub material: usize,
-    /// Camera rays pass through this mesh (a Blender light with camera visibility off);
-    /// every other ray sees it.
-    pub hidden_from_camera: bool,
     /// What shading reads beyond positions, normals and the first UV set.
     pub attrs: MeshAttributes,
 }

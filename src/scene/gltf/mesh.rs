@@ -366,7 +366,6 @@ impl<'a> Loader<'a> {
                 uvs: local.uvs.clone(),
                 indices,
                 material,
-                hidden_from_camera: false,
                 attrs,
             });
         }
