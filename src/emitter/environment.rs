@@ -249,10 +249,11 @@ pub struct Environment {
     /// The importance map; `None`: uniform over the sphere (a world whose luminance does not
     /// vary, e.g. a constant colour behind a camera-only backdrop).
     dist: Option<Box<Distribution2D>>,
-    /// `∫ luminance dω` over the sphere, for light selection (0: not a light).
-    integral: f32,
-    /// The part of `integral` that is a guided sun's irradiance.
-    sun_integral: f32,
+    /// `∫ luminance dω` of the sky over the sphere, a guided sun left out, for light
+    /// selection (0 with `sun_irradiance`: not a light).
+    sky_integral: f32,
+    /// A guided sun's luminance-weighted irradiance (0: none).
+    sun_irradiance: f32,
     /// A sky's sun sampled apart (Cycles' sun guiding): the map leaves its disc out and
     /// [`SUN_FRACTION`] of the samples are drawn uniformly in its cone.
     sun: Option<SunCone>,
@@ -312,8 +313,8 @@ impl Environment {
             program,
             camera_to_world,
             dist: None,
-            integral: 0.0,
-            sun_integral: 0.0,
+            sky_integral: 0.0,
+            sun_irradiance: 0.0,
             sun: None,
         };
         let Some([w, h, ss]) = res else {
@@ -371,11 +372,10 @@ impl Environment {
         let first = lum[0];
         if let Some(s) = &guided {
             env.sun = Some(SunCone::new(s));
-            env.sun_integral = luminance(s.power);
-            env.integral += env.sun_integral;
+            env.sun_irradiance = luminance(s.power);
         }
         if lum.iter().all(|&l| l == first) && env.sun.is_none() {
-            env.integral = if first.is_finite() {
+            env.sky_integral = if first.is_finite() {
                 first * 4.0 * PI
             } else {
                 0.0
@@ -393,12 +393,11 @@ impl Environment {
                 l * sin_t
             })
             .collect();
-        env.integral +=
+        env.sky_integral =
             (integral * 2.0 * std::f64::consts::PI * std::f64::consts::PI / (w * h) as f64) as f32;
         env.dist = Distribution2D::new(w, h, func).map(Box::new);
         if env.dist.is_none() && env.sun.is_none() {
-            env.integral = 0.0;
-            env.sun_integral = 0.0;
+            env.sky_integral = 0.0;
         }
         env
     }
@@ -499,8 +498,7 @@ impl Emitter for Environment {
     /// irradiance in full. Against the suns' `E π r²`, the flux through the sphere `∫ L dω π r²`
     /// would choose a world four times as often as its light is worth where it arrives.
     fn power(&self, _scene: &Scene, r: f32) -> f32 {
-        let sky = (self.integral - self.sun_integral).max(0.0);
-        (0.25 * sky + self.sun_integral) * PI * r * r
+        (0.25 * self.sky_integral + self.sun_irradiance) * PI * r * r
     }
 
     fn is_delta(&self) -> bool {
@@ -745,8 +743,9 @@ mod tests {
             inside / m
         );
         assert!(hits as f64 > 0.79 * m, "{hits}");
-        // The light's power counts the sun.
-        assert!(env.integral > luminance(sun.power));
+        // The light's power counts the sun, and the sky besides.
+        assert_eq!(env.sun_irradiance, luminance(sun.power));
+        assert!(env.power(&scene, 1.0) > luminance(sun.power) * PI);
     }
 
     #[test]
