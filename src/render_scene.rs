@@ -785,13 +785,20 @@ impl RenderScene {
     #[inline]
     pub fn intersect(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Option<Intersection> {
         ctx.cast(o, d, f32::INFINITY, RayKind::Closest);
-        let hit = if self.hides & !(ray::CAMERA | ray::SHADOW) == 0 {
+        let hit = if !self.hides_from_bounces() {
             self.closest(ctx, o, d, f32::INFINITY)?
         } else {
             let kind = bounce_visibility(ctx.ray_flags);
             self.closest_seen(ctx, o, d, f32::INFINITY, kind)?
         };
         Some(self.intersection(&hit, d))
+    }
+
+    /// Whether some object is hidden from rays that closures scatter (diffuse, glossy or
+    /// transmission rays).
+    #[inline]
+    fn hides_from_bounces(&self) -> bool {
+        self.hides & !(ray::CAMERA | ray::SHADOW) != 0
     }
 
     /// Whether rays of the kinds `kind` (Light Path bits) see the object of `hit`.
@@ -948,7 +955,7 @@ impl RenderScene {
     /// background costs no scene traversal at all. Not for camera rays (hidden meshes).
     #[inline]
     pub fn emission_along(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Emitted {
-        if self.passes || self.hides != 0 {
+        if self.passes || self.hides_from_bounces() {
             return self.emission_through(ctx, o, d);
         }
         let Some(emissive) = &self.emitter_accel else {
