@@ -13,6 +13,7 @@ pub mod film;
 pub mod frame;
 pub mod instancing;
 pub mod integrator;
+pub mod medium;
 pub mod output;
 pub mod protocol;
 pub mod render;

@@ -13,6 +13,7 @@ use crate::frame::Frame;
 use crate::instancing::InstanceAccel;
 use crate::integrator::MAX_TRANSPARENT;
 use crate::integrator::mis_weight;
+use crate::medium;
 use crate::scene::{Light, ObjectInfo, Scene};
 use crate::scene::{LightShape, LightVisibility};
 use crate::shading::globals::ray;
@@ -200,6 +201,13 @@ pub struct Ctx {
     /// The integrator walks subsurface closures ([`crate::integrator::subsurface`]); without
     /// it they render as diffuse.
     pub walks_subsurface: bool,
+    /// Where the current ray's direction was sampled, when the ray has since passed straight
+    /// through transparent surfaces (its origin is then not that vertex): MIS weights of the
+    /// emission it meets take light sampling's densities from there. `None`: the origin.
+    pub mis_from: Option<Vec3>,
+    /// Absorption coefficient (1/m) of the medium the current path segment travels in
+    /// ([`crate::medium`]); zero outside absorbing interiors. Shadow rays start in it.
+    pub medium: Vec3,
 }
 
 impl Ctx {
@@ -218,6 +226,8 @@ impl Ctx {
             no_caustics: 0,
             blur: 0.0,
             walks_subsurface: false,
+            mis_from: None,
+            medium: Vec3::ZERO,
         }
     }
 
@@ -245,6 +255,8 @@ pub struct RenderScene {
     pub programs: Vec<Arc<Program>>,
     /// Some material may be transparent: shadow rays and last path segments look through.
     passes: bool,
+    /// Some material has an absorbing interior ([`crate::medium`]).
+    pub absorbs: bool,
     /// The ray kinds (Light Path bits) some object is hidden from ([`ObjectInfo::visibility`]):
     /// rays of those kinds step over such objects' surfaces.
     hides: u32,
@@ -495,10 +507,12 @@ impl RenderScene {
         );
         scene.warnings.extend(warnings);
         let passes = programs.iter().any(|p| p.may_pass());
+        let absorbs = programs.iter().any(|p| p.absorption() != Vec3::ZERO);
         let hides = hidden_rays(&scene);
         RenderScene {
             scene,
             passes,
+            absorbs,
             hides,
             programs,
             camera_to_world,
@@ -560,6 +574,7 @@ impl RenderScene {
         let (programs, mut warnings) = compile_programs(&self.scene);
         self.programs = programs;
         self.passes = self.programs.iter().any(|p| p.may_pass());
+        self.absorbs = self.programs.iter().any(|p| p.absorption() != Vec3::ZERO);
         self.hides = hidden_rays(&self.scene);
         warnings.extend(self.refresh_lights());
         warnings
@@ -726,11 +741,11 @@ impl RenderScene {
                 continue;
             }
             let tr = if occlusion {
-                self.segment_transmittance(ctx, o, d, t)
+                self.segment_transmittance(ctx, o, d, t, Vec3::ZERO)
             } else {
                 Vec3::ONE
             };
-            sum += le * tr * self.forward_weight(e, &rec, bsdf_pdf);
+            sum += le * tr * self.forward_weight(e, &rec, bsdf_pdf, ctx.mis_from);
         }
         if tmax.is_infinite() {
             sum += self.suns_on_ray(ctx, o, d, depth, bsdf_pdf, occlusion);
@@ -762,22 +777,38 @@ impl RenderScene {
                 continue;
             }
             let tr = if occlusion {
-                self.segment_transmittance(ctx, o, d, f32::INFINITY)
+                self.segment_transmittance(ctx, o, d, f32::INFINITY, Vec3::ZERO)
             } else {
                 Vec3::ONE
             };
-            sum += le * tr * self.forward_weight(e, &rec, bsdf_pdf);
+            sum += le * tr * self.forward_weight(e, &rec, bsdf_pdf, ctx.mis_from);
         }
         sum
     }
 
-    /// MIS weight of light `e` met by a BSDF-sampled ray of density `bsdf_pdf`.
+    /// MIS weight of light `e` met by a BSDF-sampled ray of density `bsdf_pdf` (sampled at
+    /// `from`, if given, else at the record's reference point).
     #[inline]
-    fn forward_weight(&self, e: u32, rec: &EmitterQueryRecord, bsdf_pdf: f32) -> f32 {
+    fn forward_weight(
+        &self,
+        e: u32,
+        rec: &EmitterQueryRecord,
+        bsdf_pdf: f32,
+        from: Option<Vec3>,
+    ) -> f32 {
         if bsdf_pdf.is_infinite() {
             1.0
         } else {
-            mis_weight(bsdf_pdf, self.light_pdf(e, rec))
+            mis_weight(bsdf_pdf, self.light_pdf_from(e, rec, from))
+        }
+    }
+
+    /// [`Self::light_pdf`] of the record as seen from `from` ([`Ctx::mis_from`]), if given.
+    #[inline]
+    pub fn light_pdf_from(&self, e: u32, rec: &EmitterQueryRecord, from: Option<Vec3>) -> f32 {
+        match from {
+            None => self.light_pdf(e, rec),
+            Some(o) => self.light_pdf(e, &rec.seen_from(o)),
         }
     }
 
@@ -989,8 +1020,12 @@ impl RenderScene {
     fn emission_through(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Emitted {
         let mut tr = Vec3::ONE;
         let mut p = o;
+        let mut sigma = ctx.medium;
         for _ in 0..=MAX_TRANSPARENT {
             let hit = self.intersect(ctx, p, d);
+            if self.absorbs {
+                tr *= medium::transmittance(sigma, hit.as_ref().map_or(f32::INFINITY, |h| h.t));
+            }
             let (e, le, rec) = match &hit {
                 Some(its) => match self.emitted(its, o) {
                     Some(x) => x,
@@ -1009,6 +1044,9 @@ impl RenderScene {
             tr *= self.transparency(ctx, &its, d);
             if tr == Vec3::ZERO {
                 return None;
+            }
+            if self.absorbs {
+                sigma = medium::after(self, &its, d, d, sigma);
             }
             p = offset_origin(its.p, its.ng, d);
         }
@@ -1037,10 +1075,18 @@ impl RenderScene {
         rec: &EmitterQueryRecord,
     ) -> Vec3 {
         if !self.passes && self.hides & ray::SHADOW == 0 {
-            return if self.unoccluded(ctx, p, ng, rec) {
-                Vec3::ONE
-            } else {
+            return if !self.unoccluded(ctx, p, ng, rec) {
                 Vec3::ZERO
+            } else if ctx.medium != Vec3::ZERO {
+                // A light inside the absorbing interior the point is in.
+                let dist = if rec.dist.is_finite() {
+                    (rec.p - p).length()
+                } else {
+                    f32::INFINITY
+                };
+                medium::transmittance(ctx.medium, dist)
+            } else {
+                Vec3::ONE
             };
         }
         let o = offset_origin(p, ng, rec.wi);
@@ -1055,34 +1101,52 @@ impl RenderScene {
         } else {
             (rec.wi, f32::INFINITY)
         };
-        self.segment_transmittance(ctx, o, d, tmax)
+        self.segment_transmittance(ctx, o, d, tmax, ctx.medium)
     }
 
-    /// The transmittance of the segment `o + t d`, `t ∈ (0, tmax)`: 1 or 0 in opaque scenes,
-    /// the product of the transparent surfaces' transmittance otherwise.
-    fn segment_transmittance(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32) -> Vec3 {
+    /// The transmittance of the segment `o + t d`, `t ∈ (0, tmax)`, which starts in a medium
+    /// of absorption `sigma`: 1 or 0 in opaque scenes, the product of the transparent
+    /// surfaces' transmittance and of the absorbing interiors' ([`crate::medium`]) otherwise.
+    fn segment_transmittance(
+        &self,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        tmax: f32,
+        sigma: Vec3,
+    ) -> Vec3 {
         if !self.passes && self.hides & ray::SHADOW == 0 {
             ctx.cast(o, d, tmax, RayKind::Any);
             return if self.occluded(ctx, o, d, tmax) {
                 Vec3::ZERO
             } else {
-                Vec3::ONE
+                medium::transmittance(sigma, tmax)
             };
         }
+        // The segment ends where it ended at the start: each origin moved off a surface is
+        // a little further along, so the length left is measured to that end (subtracting
+        // the hit distances would let the offsets add up and reach the light itself).
+        let end = o + d * tmax;
         let (mut o, mut tmax) = (o, tmax);
-        let mut tr = Vec3::ONE;
+        let (mut tr, mut sigma) = (Vec3::ONE, sigma);
         for _ in 0..=MAX_TRANSPARENT {
             ctx.cast(o, d, tmax, RayKind::Closest);
             let Some(hit) = self.closest_shadowing(ctx, o, d, tmax) else {
-                return tr;
+                return tr * medium::transmittance(sigma, tmax);
             };
             let its = self.intersection(&hit, d);
             tr *= self.transparency(ctx, &its, d);
             if tr == Vec3::ZERO {
                 return tr;
             }
+            if self.absorbs {
+                tr *= medium::transmittance(sigma, hit.t);
+                sigma = medium::after(self, &its, d, d, sigma);
+            }
             o = offset_origin(its.p, its.ng, d);
-            tmax -= hit.t;
+            if tmax.is_finite() {
+                tmax = (end - o).dot(d);
+            }
             if tmax <= 0.0 {
                 return tr;
             }

@@ -258,16 +258,16 @@ class MaterialGraph:
         if disp is not None:
             graph["displacement"] = disp
             graph["displacement_method"] = compat.displacement_method(self.material)
-        if self._root(out, "Volume") is not None:
-            self.report(self.name, out, "volume shaders are not supported; the Volume input is "
-                        "ignored")
+        volume = self._root(out, "Volume")
+        if volume is not None:
+            graph["volume"] = volume
         self._mark_alpha_links(graph)
         return graph
 
     def _mark_alpha_links(self, graph):
         """props.alpha_linked of every Image Texture: whether its Alpha output is used (Cycles
         then un-premultiplies the Color output; the graph holds only nodes the output reaches)."""
-        used = {tuple(graph[k]) for k in ("surface", "displacement") if graph.get(k)}
+        used = {tuple(graph[k]) for k in ("surface", "displacement", "volume") if graph.get(k)}
         for entry in self.nodes:
             for v in entry["inputs"].values():
                 if isinstance(v, dict) and "link" in v:

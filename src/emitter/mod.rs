@@ -89,6 +89,18 @@ impl EmitterQueryRecord {
             ..Default::default()
         }
     }
+
+    /// The same emitter point seen from `origin`, a point behind `ref_p` on the same line
+    /// (the vertex a ray left before it passed straight through transparent surfaces): the
+    /// densities of light sampling are those of `origin`.
+    pub fn seen_from(&self, origin: Vec3) -> Self {
+        let mut r = *self;
+        r.ref_p = origin;
+        if r.dist.is_finite() {
+            r.dist = (r.p - origin).length();
+        }
+        r
+    }
 }
 
 /// One emitter.

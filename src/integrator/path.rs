@@ -3,12 +3,14 @@
 //! throughput's **maximum** component, survival probability capped at 0.95. Both apply
 //! Cycles' Filter Glossy ([`super::filter_glossy`]) when it is on. A vertex whose chosen
 //! closure scatters below the surface walks ([`subsurface`]) and goes on from the exit point
-//! at the same depth, lit and sampled there as a diffuse vertex.
+//! at the same depth, lit and sampled there as a diffuse vertex. Segments inside absorbing
+//! interiors are attenuated by Beer's law ([`medium`]).
 
 use super::light_paths::{BounceCount, LightPaths};
 use super::light_split::{ClassWeights, Sink, SplitsLight};
 use super::{ShadingPoint, mis_weight, sample_emitter_towards, spawn, subsurface, trace_lit};
 use crate::bsdf::Measure;
+use crate::medium;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
 
@@ -36,6 +38,13 @@ pub(super) fn report<S: Sink>(sink: &mut S, c: Vec3, depth: u32, w: &ClassWeight
             sink.bounced(c, w, depth == 2);
         }
     }
+}
+
+/// The share of light that crosses the segment to `hit` (to infinity without one) through a
+/// medium of absorption `sigma` ([`medium`]).
+#[inline]
+fn absorbed_along(sigma: Vec3, hit: Option<&crate::render_scene::Intersection>) -> Vec3 {
+    medium::transmittance(sigma, hit.map_or(f32::INFINITY, |h| h.t))
 }
 
 /// Russian roulette: returns false to terminate, else rescales `throughput`.
@@ -92,9 +101,14 @@ impl PathMats {
         let mut min_ray_pdf = f32::INFINITY;
         ctx.blur = 0.0;
         ctx.walks_subsurface = true;
+        ctx.medium = Vec3::ZERO;
         loop {
-            let last = depth >= end;
+            // Inside an absorbing interior the segment's length is needed: no shortcut.
+            let last = depth >= end && ctx.medium == Vec3::ZERO;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
+            if ctx.medium != Vec3::ZERO {
+                throughput *= absorbed_along(ctx.medium, hit.as_ref());
+            }
             let direct = depth <= 2;
             if let Some((_, le, _)) = emitted {
                 let c = self.paths.clamp(throughput * le, direct);
@@ -126,6 +140,9 @@ impl PathMats {
                     return l;
                 }
                 throughput *= sp.weight;
+                if scene.absorbs {
+                    ctx.medium = medium::after(scene, &its, d, d, ctx.medium);
+                }
                 o = spawn(&its, d);
                 continue;
             }
@@ -160,6 +177,9 @@ impl PathMats {
             // `sample` left the new ray's Light Path bits in the context.
             if counts.count(ctx.ray_flags, &self.paths) {
                 end = end.min(depth + 1);
+            }
+            if scene.absorbs {
+                ctx.medium = medium::after(scene, its, dv, wo, ctx.medium);
             }
             o = spawn(its, wo);
             d = wo;
@@ -205,20 +225,26 @@ impl PathMis {
         // Density of the BSDF sample that produced the current ray; infinite for camera rays
         // and delta samples (emitter sampling could not have produced them: MIS weight 1).
         let mut bsdf_pdf = f32::INFINITY;
+        ctx.mis_from = None;
         let (mut counts, mut end) = (BounceCount::default(), self.max_depth);
         ctx.no_caustics = self.paths.no_caustics();
         // Least BSDF density of the path's non-delta bounces (Filter Glossy).
         let mut min_ray_pdf = f32::INFINITY;
         ctx.blur = 0.0;
         ctx.walks_subsurface = true;
+        ctx.medium = Vec3::ZERO;
         loop {
-            let last = depth >= end;
+            // Inside an absorbing interior the segment's length is needed: no shortcut.
+            let last = depth >= end && ctx.medium == Vec3::ZERO;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, bsdf_pdf);
+            if ctx.medium != Vec3::ZERO {
+                throughput *= absorbed_along(ctx.medium, hit.as_ref());
+            }
             if let Some((e, le, erec)) = emitted {
                 let w = if bsdf_pdf.is_infinite() {
                     1.0
                 } else {
-                    mis_weight(bsdf_pdf, scene.light_pdf(e, &erec))
+                    mis_weight(bsdf_pdf, scene.light_pdf_from(e, &erec, ctx.mis_from))
                 };
                 let c = self.paths.clamp(throughput * le * w, depth <= 2);
                 l += c;
@@ -249,6 +275,11 @@ impl PathMis {
                     return l;
                 }
                 throughput *= sp.weight;
+                if scene.absorbs {
+                    ctx.medium = medium::after(scene, &its, d, d, ctx.medium);
+                }
+                // The ray goes on from here, but was sampled where it started.
+                ctx.mis_from.get_or_insert(o);
                 o = spawn(&its, d);
                 continue;
             }
@@ -288,6 +319,7 @@ impl PathMis {
             if S::ACTIVE && depth == 1 {
                 weights = sp.class_weights_sampled(&rec);
             }
+            ctx.mis_from = None;
             bsdf_pdf = if rec.measure == Measure::Discrete {
                 f32::INFINITY
             } else {
@@ -300,6 +332,9 @@ impl PathMis {
             // `sample` left the new ray's Light Path bits in the context.
             if counts.count(ctx.ray_flags, &self.paths) {
                 end = end.min(depth + 1);
+            }
+            if scene.absorbs {
+                ctx.medium = medium::after(scene, its, dv, wo, ctx.medium);
             }
             o = spawn(its, wo);
             d = wo;

@@ -300,15 +300,30 @@ pub struct Anisotropy {
     pub texture: Option<TexRef>,
 }
 
-/// `KHR_materials_volume`, kept for the record: the renderer refracts through transmissive
-/// meshes as solids whatever the thickness, and does not render attenuation yet.
+/// `KHR_materials_volume`: the renderer refracts through transmissive meshes as solids
+/// whatever the thickness, and attenuates light inside them by Beer's law.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Volume {
     /// 0 = thin-walled.
     pub thickness: f32,
+    /// The colour white light becomes after `attenuation_distance` inside.
     pub attenuation_color: Vec3,
     /// Metres; infinite = no attenuation.
     pub attenuation_distance: f32,
+}
+
+impl Volume {
+    /// The interior's absorption coefficient, 1/m: `σ_a = -ln(c) / d` per channel (the
+    /// extension's definition), zero for thin-walled or non-attenuating volumes. A colour
+    /// channel of 0 (an infinite coefficient) is taken as 1e-6.
+    pub fn absorption(&self) -> Vec3 {
+        let d = self.attenuation_distance;
+        if self.thickness <= 0.0 || !d.is_finite() || d <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let c = self.attenuation_color.clamp(Vec3::splat(1e-6), Vec3::ONE);
+        Vec3::new(-c.x.ln(), -c.y.ln(), -c.z.ln()) / d
+    }
 }
 
 /// glTF metallic-roughness material with the KHR extensions Tesela understands.

@@ -152,6 +152,9 @@ pub struct ClosureSet {
     pub len: usize,
     /// Emitted radiance, W/(m² sr) (sum of emission closures times their weights).
     pub emission: Vec3,
+    /// Absorption coefficient σ_a per channel, 1/m (a volume's absorption closures times
+    /// their weights; zero for surfaces).
+    pub absorption: Vec3,
 }
 
 const EMPTY: Closure = Closure {
@@ -168,6 +171,7 @@ impl Default for ClosureSet {
             closures: [EMPTY; MAX_CLOSURES],
             len: 0,
             emission: Vec3::ZERO,
+            absorption: Vec3::ZERO,
         }
     }
 }
@@ -176,6 +180,7 @@ impl ClosureSet {
     pub fn clear(&mut self) {
         self.len = 0;
         self.emission = Vec3::ZERO;
+        self.absorption = Vec3::ZERO;
     }
 
     /// The closures present.
@@ -204,6 +209,12 @@ impl ClosureSet {
     pub fn add_emission(&mut self, e: Vec3) {
         if e.is_finite() {
             self.emission += e.max(Vec3::ZERO);
+        }
+    }
+
+    pub fn add_absorption(&mut self, sigma: Vec3) {
+        if sigma.is_finite() {
+            self.absorption += sigma.max(Vec3::ZERO);
         }
     }
 

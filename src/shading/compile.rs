@@ -8,7 +8,6 @@
 //! evaluates a muted node (its internal links, else zero) and reported once in `warnings`,
 //! naming the material and the node.
 
-use super::closure::ClosureSet;
 use super::graph::{Graph, Input};
 use super::nodes;
 use super::program::{Op, Program, Slot};
@@ -78,6 +77,8 @@ pub struct Compiler<'g> {
     varying: bool,
     /// A displacement replaced `N`: closures without a Normal input take the displaced one.
     displaced: bool,
+    /// Compiling what reaches the Volume input (volume closures), not the Surface.
+    volume: bool,
 }
 
 /// The result of compiling a material.
@@ -89,28 +90,27 @@ pub struct Compiled {
 
 /// Compiles `graph` of material `material`.
 pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, CompileError> {
-    let mut c = Compiler {
-        graph,
-        material,
-        ops: Vec::new(),
-        init: Vec::new(),
-        state: HashMap::new(),
-        bump: 0,
-        consts: HashMap::new(),
-        warnings: Vec::new(),
-        may_emit: false,
-        may_pass: false,
-        may_scatter_below: false,
-        varying: false,
-        displaced: false,
-    };
+    let mut c = Compiler::new(graph, material, false);
     if let Some((node, output)) = &graph.displacement {
         c.displacement_as_bump(*node, output)?;
     }
     if let Some((node, output)) = &graph.surface {
         let one = c.constant(&[1.0])?;
         c.shader_link(*node, output, one)?;
+    } else if graph.volume.is_some() {
+        // Only a volume: the surface lets rays into it (Cycles' SD_HAS_ONLY_VOLUME).
+        let one = c.constant(&[1.0])?;
+        let white = c.constant(&[1.0; 3])?;
+        c.may_pass = true;
+        c.push(
+            Op::Closure(nodes::bsdf::ClosureOp::transparent(one, white)),
+            false,
+        );
     }
+    let (absorption, volume_warnings) = match &graph.volume {
+        Some((node, output)) => compile_volume(graph, material, *node, output)?,
+        None => (Vec3::ZERO, Vec::new()),
+    };
     let mut program = Program {
         ops: c.ops,
         init: c.init,
@@ -118,19 +118,11 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
         may_emit: c.may_emit,
         may_pass: c.may_pass,
         may_scatter_below: c.may_scatter_below,
+        absorption,
     };
     if !c.varying {
         // Closure operations read only constant slots: run once now.
-        let globals = super::globals::ShaderGlobals::at(Vec3::ZERO, Vec3::Z, glam::Vec2::ZERO);
-        let env = super::globals::ShadeEnv {
-            images: &[],
-            textures: &[],
-            camera_to_world: glam::Mat4::IDENTITY,
-            tracer: None,
-        };
-        let mut scratch = super::program::Scratch::default();
-        program.run(&globals, &env, &mut scratch);
-        let set: ClosureSet = scratch.set.clone();
+        let set = program.run_at_origin();
         program.may_emit = set.emission.max_element() > 0.0;
         program.may_pass = set
             .closures()
@@ -138,13 +130,59 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
             .any(|c| matches!(c.kind, super::ClosureKind::Transparent { .. }));
         program.constant = Some(set);
     }
-    Ok(Compiled {
-        program,
-        warnings: c.warnings,
-    })
+    let mut warnings = c.warnings;
+    warnings.extend(volume_warnings);
+    Ok(Compiled { program, warnings })
+}
+
+/// The absorption coefficient of the volume `(node, output)` feeds into the material output's
+/// Volume, and what was reported. The interior is homogeneous: a volume whose inputs vary
+/// through space is evaluated once, at the origin, and reported.
+fn compile_volume(
+    graph: &Graph,
+    material: &str,
+    node: usize,
+    output: &str,
+) -> std::result::Result<(Vec3, Vec<String>), CompileError> {
+    let mut c = Compiler::new(graph, material, true);
+    let one = c.constant(&[1.0])?;
+    c.shader_link(node, output, one)?;
+    if c.varying {
+        let n = &graph.nodes[node];
+        c.warn(format!(
+            "material '{material}': the volume from node '{}' ({}) varies through space; it renders \
+             homogeneous, with its value at the origin",
+            n.name, n.kind
+        ));
+    }
+    let program = Program {
+        ops: c.ops,
+        init: c.init,
+        ..Program::default()
+    };
+    Ok((program.run_at_origin().absorption, c.warnings))
 }
 
 impl<'g> Compiler<'g> {
+    fn new(graph: &'g Graph, material: &'g str, volume: bool) -> Self {
+        Compiler {
+            graph,
+            material,
+            ops: Vec::new(),
+            init: Vec::new(),
+            state: HashMap::new(),
+            bump: 0,
+            consts: HashMap::new(),
+            warnings: Vec::new(),
+            may_emit: false,
+            may_pass: false,
+            may_scatter_below: false,
+            varying: false,
+            displaced: false,
+            volume,
+        }
+    }
+
     /// The material output's Displacement as Cycles' "Bump Only": the displacement vector at
     /// the point and its two offsets, the displaced normal from them, and a Set Normal that
     /// the surface graph (compiled afterwards, from scratch) sees as `N`. True displacement of
@@ -387,6 +425,11 @@ impl<'g> NodeCx<'_, 'g> {
     }
 
     /// The material's displacement replaced the shading normal `N`.
+    /// Whether the node is reached from the Volume input.
+    pub fn in_volume(&self) -> bool {
+        self.c.volume
+    }
+
     pub fn displaced(&self) -> bool {
         self.c.displaced
     }

@@ -81,6 +81,8 @@ pub struct Graph {
     pub surface: Option<(usize, String)>,
     /// What reaches the material output's Displacement.
     pub displacement: Option<(usize, String)>,
+    /// What reaches the material output's Volume: the closed mesh's interior.
+    pub volume: Option<(usize, String)>,
     /// The material's displacement method: `"BUMP"` (Blender's default, also when absent),
     /// `"DISPLACEMENT"` or `"BOTH"`.
     pub displacement_method: String,
@@ -167,6 +169,7 @@ impl Graph {
         Ok(Graph {
             surface: output("surface")?,
             displacement: output("displacement")?,
+            volume: output("volume")?,
             displacement_method: match obj.get("displacement_method") {
                 None | Some(Value::Null) => "BUMP".to_string(),
                 Some(Value::String(m)) => m.clone(),

@@ -43,7 +43,10 @@ pub fn material_program(m: &Material, textures: &[Texture]) -> Compiled {
             }
         }
     }
-    compile(&preset::metallic_roughness(m, textures), &m.name).expect("the preset graph compiles")
+    let mut c = compile(&preset::metallic_roughness(m, textures), &m.name)
+        .expect("the preset graph compiles");
+    c.program.absorption = m.volume.map_or(glam::Vec3::ZERO, |v| v.absorption());
+    c
 }
 
 #[cfg(test)]

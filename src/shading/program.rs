@@ -102,6 +102,9 @@ pub struct Program {
     pub(crate) may_pass: bool,
     /// Whether a subsurface closure can come out of the program.
     pub(crate) may_scatter_below: bool,
+    /// Absorption coefficient σ_a of the mesh's interior per channel, 1/m (the material's
+    /// volume); zero: the interior is clear.
+    pub(crate) absorption: Vec3,
 }
 
 impl Program {
@@ -119,6 +122,29 @@ impl Program {
         }
         self.run(g, env, scratch);
         &scratch.set
+    }
+
+    /// The closures at a default shading point (at the origin, facing +Z): for programs
+    /// whose closures do not depend on the point.
+    pub(crate) fn run_at_origin(&self) -> ClosureSet {
+        let globals = ShaderGlobals::at(Vec3::ZERO, Vec3::Z, glam::Vec2::ZERO);
+        let env = ShadeEnv {
+            images: &[],
+            textures: &[],
+            camera_to_world: glam::Mat4::IDENTITY,
+            tracer: None,
+        };
+        let mut scratch = Scratch::default();
+        self.run(&globals, &env, &mut scratch);
+        scratch.set
+    }
+
+    /// Absorption coefficient σ_a of the interior of meshes with this material, per channel,
+    /// 1/m (zero: clear). Rays between entering and leaving such a mesh are attenuated by
+    /// `exp(-σ_a t)`.
+    #[inline(always)]
+    pub fn absorption(&self) -> Vec3 {
+        self.absorption
     }
 
     /// The closures of a program that does not depend on the shading point.

@@ -728,7 +728,10 @@ def test_reports_once_per_material_and_node(addon, tmp_path):
     addon_lines, renderer_lines = last.for_material("Troubled")
     assert renderer_lines == []
     text = "\n".join(addon_lines)
-    assert sum("volume shaders are not supported" in ln for ln in addon_lines) == 1
+    # The Volume is exported for the renderer, which reports what it cannot render there.
+    vi, _ = node(g, vol.name)
+    assert g["volume"] == [vi, "Volume"]
+    assert not any("volume" in ln for ln in addon_lines)
     assert sum("node 'Infinite'" in ln and "not finite" in ln for ln in addon_lines) == 1
     lost = [ln for ln in addon_lines if "'Gone' has no pixels" in ln]
     assert len(lost) == 2 and "node 'Lost Texture'" in text and "node 'Lost Again'" in text
@@ -788,7 +791,6 @@ def test_engine_files_renderer_lines_under_materials(addon, tmp_path, monkeypatc
     assert bpy.ops.render.render() == {"FINISHED"}
     last = report.get(scene.name)
     addon_lines, renderer_lines = last.for_material("Rendered")
-    assert any("volume shaders are not supported" in ln for ln in addon_lines)
     assert any("node 'Magic' (ShaderNodeTexMagic)" in ln for ln in renderer_lines)
     assert any("node 'Bright' (ShaderNodeTexBrick)" in ln for ln in renderer_lines)
     # The Material tab panel lists both.

@@ -472,7 +472,7 @@ impl<'a> Loader<'a> {
 
     /// `KHR_materials_volume`: the renderer refracts through every transmissive mesh as a solid
     /// (as Cycles does), so thin-walled (thickness 0) surfaces render as solids, with a note;
-    /// attenuation is not rendered yet, with a warning. The thickness texture only serves
+    /// attenuation applies inside the mesh (Beer's law). The thickness texture only serves
     /// rasterisers' approximations and is not needed by a path tracer.
     fn volume(
         &mut self,
@@ -517,15 +517,15 @@ impl<'a> Loader<'a> {
             );
         }
         if transmissive
+            && thickness == 0.0
             && attenuation_distance.is_finite()
-            && attenuation_distance > 0.0
             && attenuation_color != Vec3::ONE
         {
             self.warn_material(
                 gi,
                 name,
                 format!(
-                    "{what}: attenuation (colour {attenuation_color}, distance {attenuation_distance} m) is not rendered yet; the volume is clear"
+                    "{what}: attenuation (colour {attenuation_color}, distance {attenuation_distance} m) applies only to volumes (thickness > 0); the thin-walled interior renders clear"
                 ),
             );
         }

@@ -135,6 +135,12 @@ pub enum ClosureParams {
         color: Slot,
         strength: Slot,
     },
+    /// The Volume Absorption node: `σ_a = density · max(1 - color, 0)` (Cycles' absorption
+    /// closure), 1/m.
+    Absorption {
+        color: Slot,
+        density: Slot,
+    },
     /// Mix Shader weights: `out1 = w (1 - clamp(fac)), out2 = w clamp(fac)`.
     MixWeights {
         fac: Slot,
@@ -151,6 +157,15 @@ pub struct ClosureOp {
 }
 
 impl ClosureOp {
+    /// A constant-white Transparent BSDF of weight `weight`: the surface of a mesh whose
+    /// material has only a volume (Cycles lets rays through it into the volume).
+    pub fn transparent(weight: Slot, color: Slot) -> ClosureOp {
+        ClosureOp {
+            weight,
+            params: ClosureParams::Transparent { color },
+        }
+    }
+
     pub fn emission(weight: Slot, color: Slot, strength: Slot) -> ClosureOp {
         ClosureOp {
             weight,
@@ -423,9 +438,36 @@ impl ClosureOp {
             ClosureParams::Emission { color, strength } => {
                 out.add_emission(col(*color) * s.f(*strength) * w);
             }
+            ClosureParams::Absorption { color, density } => {
+                let sigma = (Vec3::ONE - col(*color)).max(Vec3::ZERO) * s.f(*density).max(0.0);
+                out.add_absorption(sigma * w);
+            }
             ClosureParams::MixWeights { .. } => {}
         }
     }
+}
+
+/// A shader node reached from the material output's Volume: Volume Absorption is rendered
+/// (a homogeneous absorbing interior); other nodes are reported and add nothing there, as
+/// Cycles ignores surface closures in a volume.
+fn compile_volume_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, CompileError> {
+    match kind {
+        "ShaderNodeVolumeAbsorption" => {
+            let params = ClosureParams::Absorption {
+                color: cx.color("Color", Vec3::splat(0.8))?,
+                density: cx.float("Density", 1.0)?,
+            };
+            cx.emit(Op::Closure(ClosureOp { weight: w, params }), false);
+        }
+        "ShaderNodeVolumeScatter" | "ShaderNodeVolumePrincipled" => {
+            cx.warn("volume scattering is not rendered yet; the volume renders clear")
+        }
+        _ if kind.starts_with("ShaderNodeBsdf") || kind == "ShaderNodeBsdfPrincipled" => {
+            cx.warn("a surface shader in the Volume input renders nothing there, as in Cycles")
+        }
+        _ => cx.warn("this shader is not rendered in a volume; the volume renders clear"),
+    }
+    Ok(true)
 }
 
 /// A physical conductor's complex IOR as the F82-tint model's base colour and edge tint that
@@ -512,6 +554,7 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
             return Ok(true);
         }
         "ShaderNodeBackground" => return super::environment::compile_background(cx, w),
+        _ if cx.in_volume() => return compile_volume_closure(kind, cx, w),
         "ShaderNodeBsdfPrincipled" => {
             let f = |cx: &mut NodeCx, id: &str, d: f32| cx.float(id, d);
             let c = |cx: &mut NodeCx, id: &str, d: Vec3| cx.color(id, d);
