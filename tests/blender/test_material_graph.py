@@ -782,6 +782,10 @@ def test_engine_files_renderer_lines_under_materials(addon, tmp_path, monkeypatc
     mat, nt, out = new_material("Rendered")
     vol = nt.nodes.new("ShaderNodeVolumeScatter")
     nt.links.new(vol.outputs[0], out.inputs["Volume"])
+    inf = nt.nodes.new("ShaderNodeMath")  # a value the add-on reports (written as 0)
+    inf.name = "Infinite"
+    inf.inputs[0].default_value = inf.inputs[1].default_value = float("nan")
+    nt.links.new(inf.outputs[0], vol.inputs["Density"])
     plane(scene, "P", [mat])
     fake = tmp_path / "fake-logs"
     fake.write_text(FAKE_WITH_LOGS % {"python": sys.executable, "repo": str(REPO)})
@@ -813,7 +817,7 @@ def test_engine_files_renderer_lines_under_materials(addon, tmp_path, monkeypatc
     assert panel.poll(ctx)
     panel.draw(SimpleNamespace(layout=Layout()), ctx)
     assert "Add-on" in drawn and "Renderer" in drawn
-    assert any(t.startswith("node 'Material Output'") for t in drawn)  # material prefix dropped
+    assert any(t.startswith("node 'Infinite'") for t in drawn)  # material prefix dropped
     assert any("node 'Magic' (ShaderNodeTexMagic)" in t for t in drawn)
     drawn.clear()
     panel.draw(SimpleNamespace(layout=Layout()), SimpleNamespace(material=bpy.data.materials.new("Clean"),
