@@ -1065,7 +1065,8 @@ impl RenderScene {
 
     /// The fraction of light from the emitter sample `rec` that reaches surface point `p`
     /// (geometric normal `ng`): 1 or 0 for opaque scenes, the product of the transparent
-    /// surfaces' transmittance in between otherwise.
+    /// surfaces' and the absorbing interiors' transmittance in between otherwise (starting
+    /// in `ctx.medium`).
     #[inline]
     pub fn transmittance(
         &self,
@@ -1074,19 +1075,11 @@ impl RenderScene {
         ng: Vec3,
         rec: &EmitterQueryRecord,
     ) -> Vec3 {
-        if !self.passes && self.hides & ray::SHADOW == 0 {
-            return if !self.unoccluded(ctx, p, ng, rec) {
-                Vec3::ZERO
-            } else if ctx.medium != Vec3::ZERO {
-                // A light inside the absorbing interior the point is in.
-                let dist = if rec.dist.is_finite() {
-                    (rec.p - p).length()
-                } else {
-                    f32::INFINITY
-                };
-                medium::transmittance(ctx.medium, dist)
-            } else {
+        if !self.passes && self.hides & ray::SHADOW == 0 && ctx.medium == Vec3::ZERO {
+            return if self.unoccluded(ctx, p, ng, rec) {
                 Vec3::ONE
+            } else {
+                Vec3::ZERO
             };
         }
         let o = offset_origin(p, ng, rec.wi);

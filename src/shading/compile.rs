@@ -424,12 +424,12 @@ impl<'g> NodeCx<'_, 'g> {
         self.partial = true;
     }
 
-    /// The material's displacement replaced the shading normal `N`.
     /// Whether the node is reached from the Volume input.
     pub fn in_volume(&self) -> bool {
         self.c.volume
     }
 
+    /// The material's displacement replaced the shading normal `N`.
     pub fn displaced(&self) -> bool {
         self.c.displaced
     }
