@@ -187,6 +187,10 @@ struct RenderArgs {
     /// Most transmission bounces (Cycles' transmission_bounces).
     #[arg(long, value_name = "N")]
     transmission_bounces: Option<u32>,
+    /// Most volume scatter bounces (Cycles' volume_bounces; the add-on passes Blender's
+    /// setting, whose default is 0: single scattering).
+    #[arg(long, value_name = "N")]
+    volume_bounces: Option<u32>,
     /// Most transparent surfaces passed straight through (Cycles' transparent_max_bounces).
     #[arg(long, default_value_t = 8, value_name = "N")]
     transparent_bounces: u32,
@@ -587,6 +591,7 @@ fn options(args: &RenderArgs, scene: &Scene) -> RenderOptions {
             diffuse: args.diffuse_bounces.unwrap_or(u32::MAX),
             glossy: args.glossy_bounces.unwrap_or(u32::MAX),
             transmission: args.transmission_bounces.unwrap_or(u32::MAX),
+            volume: args.volume_bounces.unwrap_or(u32::MAX),
             transparent: args.transparent_bounces,
             clamp_direct: args.clamp_direct,
             clamp_indirect: args.clamp_indirect,

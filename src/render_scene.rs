@@ -13,7 +13,7 @@ use crate::frame::Frame;
 use crate::instancing::InstanceAccel;
 use crate::integrator::MAX_TRANSPARENT;
 use crate::integrator::mis_weight;
-use crate::medium;
+use crate::medium::{self, Medium};
 use crate::scene::{Light, ObjectInfo, Scene};
 use crate::scene::{LightShape, LightVisibility};
 use crate::shading::globals::ray;
@@ -205,9 +205,9 @@ pub struct Ctx {
     /// through transparent surfaces (its origin is then not that vertex): MIS weights of the
     /// emission it meets take light sampling's densities from there. `None`: the origin.
     pub mis_from: Option<Vec3>,
-    /// Absorption coefficient (1/m) of the medium the current path segment travels in
-    /// ([`crate::medium`]); zero outside absorbing interiors. Shadow rays start in it.
-    pub medium: Vec3,
+    /// The medium the current path segment travels in ([`crate::medium`]); clear outside
+    /// interiors with a volume. Shadow rays start in it.
+    pub medium: Medium,
 }
 
 impl Ctx {
@@ -227,7 +227,7 @@ impl Ctx {
             blur: 0.0,
             walks_subsurface: false,
             mis_from: None,
-            medium: Vec3::ZERO,
+            medium: Medium::default(),
         }
     }
 
@@ -255,8 +255,10 @@ pub struct RenderScene {
     pub programs: Vec<Arc<Program>>,
     /// Some material may be transparent: shadow rays and last path segments look through.
     passes: bool,
-    /// Some material has an absorbing interior ([`crate::medium`]).
+    /// Some material has an interior with a volume ([`crate::medium`]).
     pub absorbs: bool,
+    /// The medium the camera is in (clear unless it sits inside a mesh with a volume).
+    pub camera_medium: Medium,
     /// The ray kinds (Light Path bits) some object is hidden from ([`ObjectInfo::visibility`]):
     /// rays of those kinds step over such objects' surfaces.
     hides: u32,
@@ -507,12 +509,13 @@ impl RenderScene {
         );
         scene.warnings.extend(warnings);
         let passes = programs.iter().any(|p| p.may_pass());
-        let absorbs = programs.iter().any(|p| p.absorption() != Vec3::ZERO);
+        let absorbs = programs.iter().any(|p| !p.medium().is_clear());
         let hides = hidden_rays(&scene);
-        RenderScene {
+        let mut rs = RenderScene {
             scene,
             passes,
             absorbs,
+            camera_medium: Medium::default(),
             hides,
             programs,
             camera_to_world,
@@ -530,7 +533,40 @@ impl RenderScene {
             lights: parts.lights,
             radius,
             choice,
+        };
+        rs.camera_medium = rs.camera_medium();
+        rs
+    }
+
+    /// The medium around the camera's position: the interior of the first mesh with a volume
+    /// that a ray from there meets from behind (meshes are closed: Cycles' volume stack
+    /// initialisation, from the camera's position instead of each ray's origin).
+    fn camera_medium(&self) -> Medium {
+        let Some(camera) = self.scene.camera.as_ref() else {
+            return Medium::default();
+        };
+        if !self.absorbs {
+            return Medium::default();
         }
+        let mut ctx = Ctx::new(crate::sampler::SobolSampler::new(0, 0, 0));
+        // Any direction does for a closed mesh; this one is off every axis and diagonal.
+        let d = Vec3::new(0.2673, 0.5345, 0.8018).normalize();
+        let mut o = camera.to_world.w_axis.truncate();
+        for _ in 0..MAX_HIDDEN_SKIPS {
+            let Some(its) = self.intersect(&mut ctx, o, d) else {
+                break;
+            };
+            let m = self.programs[its.material as usize].medium();
+            if !m.is_clear() {
+                return if d.dot(its.ng) > 0.0 {
+                    *m
+                } else {
+                    Medium::default()
+                };
+            }
+            o = offset_origin(its.p, its.ng, d);
+        }
+        Medium::default()
     }
 
     fn set_lights(&mut self, p: LightParts) {
@@ -574,8 +610,9 @@ impl RenderScene {
         let (programs, mut warnings) = compile_programs(&self.scene);
         self.programs = programs;
         self.passes = self.programs.iter().any(|p| p.may_pass());
-        self.absorbs = self.programs.iter().any(|p| p.absorption() != Vec3::ZERO);
+        self.absorbs = self.programs.iter().any(|p| !p.medium().is_clear());
         self.hides = hidden_rays(&self.scene);
+        self.camera_medium = self.camera_medium();
         warnings.extend(self.refresh_lights());
         warnings
     }
@@ -741,7 +778,7 @@ impl RenderScene {
                 continue;
             }
             let tr = if occlusion {
-                self.segment_transmittance(ctx, o, d, t, Vec3::ZERO)
+                self.segment_transmittance(ctx, o, d, t, Medium::default())
             } else {
                 Vec3::ONE
             };
@@ -777,7 +814,7 @@ impl RenderScene {
                 continue;
             }
             let tr = if occlusion {
-                self.segment_transmittance(ctx, o, d, f32::INFINITY, Vec3::ZERO)
+                self.segment_transmittance(ctx, o, d, f32::INFINITY, Medium::default())
             } else {
                 Vec3::ONE
             };
@@ -1020,11 +1057,12 @@ impl RenderScene {
     fn emission_through(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Emitted {
         let mut tr = Vec3::ONE;
         let mut p = o;
-        let mut sigma = ctx.medium;
+        let mut m = ctx.medium;
         for _ in 0..=MAX_TRANSPARENT {
             let hit = self.intersect(ctx, p, d);
             if self.absorbs {
-                tr *= medium::transmittance(sigma, hit.as_ref().map_or(f32::INFINITY, |h| h.t));
+                let t = hit.as_ref().map_or(f32::INFINITY, |h| h.t);
+                tr *= medium::transmittance(m.sigma_t(), t);
             }
             let (e, le, rec) = match &hit {
                 Some(its) => match self.emitted(its, o) {
@@ -1046,7 +1084,7 @@ impl RenderScene {
                 return None;
             }
             if self.absorbs {
-                sigma = medium::after(self, &its, d, d, sigma);
+                m = medium::after(self, &its, d, d, m);
             }
             p = offset_origin(its.p, its.ng, d);
         }
@@ -1075,7 +1113,7 @@ impl RenderScene {
         ng: Vec3,
         rec: &EmitterQueryRecord,
     ) -> Vec3 {
-        if !self.passes && self.hides & ray::SHADOW == 0 && ctx.medium == Vec3::ZERO {
+        if !self.passes && self.hides & ray::SHADOW == 0 && ctx.medium.is_clear() {
             return if self.unoccluded(ctx, p, ng, rec) {
                 Vec3::ONE
             } else {
@@ -1097,23 +1135,16 @@ impl RenderScene {
         self.segment_transmittance(ctx, o, d, tmax, ctx.medium)
     }
 
-    /// The transmittance of the segment `o + t d`, `t ∈ (0, tmax)`, which starts in a medium
-    /// of absorption `sigma`: 1 or 0 in opaque scenes, the product of the transparent
-    /// surfaces' transmittance and of the absorbing interiors' ([`crate::medium`]) otherwise.
-    fn segment_transmittance(
-        &self,
-        ctx: &mut Ctx,
-        o: Vec3,
-        d: Vec3,
-        tmax: f32,
-        sigma: Vec3,
-    ) -> Vec3 {
+    /// The transmittance of the segment `o + t d`, `t ∈ (0, tmax)`, which starts in medium
+    /// `m`: 1 or 0 in opaque scenes, the product of the transparent surfaces' transmittance
+    /// and of the interiors' extinction ([`crate::medium`]) otherwise.
+    fn segment_transmittance(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32, m: Medium) -> Vec3 {
         if !self.passes && self.hides & ray::SHADOW == 0 {
             ctx.cast(o, d, tmax, RayKind::Any);
             return if self.occluded(ctx, o, d, tmax) {
                 Vec3::ZERO
             } else {
-                medium::transmittance(sigma, tmax)
+                medium::transmittance(m.sigma_t(), tmax)
             };
         }
         // The segment ends where it ended at the start: each origin moved off a surface is
@@ -1121,11 +1152,11 @@ impl RenderScene {
         // the hit distances would let the offsets add up and reach the light itself).
         let end = o + d * tmax;
         let (mut o, mut tmax) = (o, tmax);
-        let (mut tr, mut sigma) = (Vec3::ONE, sigma);
+        let (mut tr, mut m) = (Vec3::ONE, m);
         for _ in 0..=MAX_TRANSPARENT {
             ctx.cast(o, d, tmax, RayKind::Closest);
             let Some(hit) = self.closest_shadowing(ctx, o, d, tmax) else {
-                return tr * medium::transmittance(sigma, tmax);
+                return tr * medium::transmittance(m.sigma_t(), tmax);
             };
             let its = self.intersection(&hit, d);
             tr *= self.transparency(ctx, &its, d);
@@ -1133,8 +1164,8 @@ impl RenderScene {
                 return tr;
             }
             if self.absorbs {
-                tr *= medium::transmittance(sigma, hit.t);
-                sigma = medium::after(self, &its, d, d, sigma);
+                tr *= medium::transmittance(m.sigma_t(), hit.t);
+                m = medium::after(self, &its, d, d, m);
             }
             o = offset_origin(its.p, its.ng, d);
             if tmax.is_finite() {

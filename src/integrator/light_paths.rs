@@ -15,6 +15,8 @@ pub struct LightPaths {
     pub diffuse: u32,
     pub glossy: u32,
     pub transmission: u32,
+    /// Most volume scatter bounces (Cycles' `volume_bounces`): as the kinds above.
+    pub volume: u32,
     /// Transparent surfaces a path goes straight through (`transparent_max_bounces`).
     pub transparent: u32,
     /// Cycles' `sample_clamp_direct` / `sample_clamp_indirect`: a contribution whose
@@ -44,6 +46,7 @@ impl Default for LightPaths {
             diffuse: u32::MAX,
             glossy: u32::MAX,
             transmission: u32::MAX,
+            volume: u32::MAX,
             transparent: MAX_TRANSPARENT,
             clamp_direct: 0.0,
             clamp_indirect: 0.0,
@@ -91,6 +94,7 @@ pub struct BounceCount {
     diffuse: u32,
     glossy: u32,
     transmission: u32,
+    volume: u32,
 }
 
 impl BounceCount {
@@ -99,7 +103,10 @@ impl BounceCount {
     /// passed its limit in `paths` (a limit of 1 allows one bounce that still finds lights).
     #[inline]
     pub fn count(&mut self, flags: u32, paths: &LightPaths) -> bool {
-        if flags & ray::TRANSMISSION != 0 {
+        if flags & ray::VOLUME != 0 {
+            self.volume += 1;
+            self.volume > paths.volume
+        } else if flags & ray::TRANSMISSION != 0 {
             self.transmission += 1;
             self.transmission > paths.transmission
         } else if flags & ray::DIFFUSE != 0 {
@@ -149,5 +156,12 @@ mod tests {
         assert!(!b.count(refraction, &p), "refraction is transmission");
         assert!(!b.count(ray::GLOSSY | ray::SINGULAR | ray::REFLECTION, &p));
         assert!(b.count(ray::GLOSSY | ray::REFLECTION, &p));
+        let p = LightPaths {
+            volume: 0,
+            ..Default::default()
+        };
+        let mut b = BounceCount::default();
+        assert!(b.count(ray::VOLUME, &p), "no volume bounce allowed");
+        assert!(!b.count(ray::DIFFUSE | ray::REFLECTION, &p));
     }
 }

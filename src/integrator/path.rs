@@ -3,15 +3,18 @@
 //! throughput's **maximum** component, survival probability capped at 0.95. Both apply
 //! Cycles' Filter Glossy ([`super::filter_glossy`]) when it is on. A vertex whose chosen
 //! closure scatters below the surface walks ([`subsurface`]) and goes on from the exit point
-//! at the same depth, lit and sampled there as a diffuse vertex. Segments inside absorbing
-//! interiors are attenuated by Beer's law ([`medium`]).
+//! at the same depth, lit and sampled there as a diffuse vertex. Segments inside interiors
+//! with a volume ([`medium`]) are attenuated by Beer's law, or, where the medium scatters,
+//! end where a sampled free flight ends: a volume vertex lit (path_mis) and scattered by its
+//! phase function, counted as a volume bounce.
 
 use super::light_paths::{BounceCount, LightPaths};
 use super::light_split::{ClassWeights, Sink, SplitsLight};
 use super::{ShadingPoint, mis_weight, sample_emitter_towards, spawn, subsurface, trace_lit};
 use crate::bsdf::Measure;
-use crate::medium;
-use crate::render_scene::{Ctx, RenderScene};
+use crate::medium::{self, FreeFlight};
+use crate::render_scene::{Ctx, Emitted, Intersection, RenderScene};
+use crate::shading::globals::ray;
 use glam::Vec3;
 
 /// Depth (vertex count) from which Russian roulette applies.
@@ -40,11 +43,93 @@ pub(super) fn report<S: Sink>(sink: &mut S, c: Vec3, depth: u32, w: &ClassWeight
     }
 }
 
-/// The share of light that crosses the segment to `hit` (to infinity without one) through a
-/// medium of absorption `sigma` ([`medium`]).
+/// Applies the medium `ctx.medium` to the segment from `o` along `d` that ended at `hit`
+/// (none: it left the scene), met with `emitted` and `lights` at and before its end, for a
+/// path of `throughput` at vertex `depth`. An absorbing medium attenuates by Beer's law. In a
+/// scattering or emitting one ([`medium`]) the segment's emission is added to `l`, and a free
+/// flight is sampled: when it ends before `hit`, what lay beyond is dropped, the light shapes
+/// met before it are added, and the point where the light scattered is returned.
+#[allow(clippy::too_many_arguments)]
 #[inline]
-fn absorbed_along(sigma: Vec3, hit: Option<&crate::render_scene::Intersection>) -> Vec3 {
-    medium::transmittance(sigma, hit.map_or(f32::INFINITY, |h| h.t))
+fn through_medium<S: Sink>(
+    paths: &LightPaths,
+    scene: &RenderScene,
+    ctx: &mut Ctx,
+    (o, d, depth, bsdf_pdf): (Vec3, Vec3, u32, f32),
+    hit: Option<&Intersection>,
+    emitted: &mut Emitted,
+    lights: &mut Vec3,
+    throughput: &mut Vec3,
+    (l, sink, weights): (&mut Vec3, &mut S, &ClassWeights),
+) -> Option<Vec3> {
+    let m = ctx.medium;
+    let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
+    if !m.scatters_or_emits() {
+        *throughput *= medium::transmittance(m.sigma_t(), t_hit);
+        return None;
+    }
+    let e = m.emitted_along(t_hit);
+    if e != Vec3::ZERO {
+        let c = paths.clamp(*throughput * e, depth <= 2);
+        *l += c;
+        report(sink, c, depth, weights);
+    }
+    match m.sample_free_flight(t_hit, *throughput, ctx.sampler.next_2d()) {
+        FreeFlight::Pass { weight } => {
+            *throughput *= weight;
+            None
+        }
+        FreeFlight::Scatter { t, weight, passing } => {
+            *emitted = None;
+            *lights = Vec3::ZERO;
+            if scene.has_light_shapes() {
+                let seen = scene.lights_on_ray(ctx, o, d, t, depth, bsdf_pdf, false);
+                if seen != Vec3::ZERO {
+                    let c = paths.clamp(*throughput * seen * passing, depth <= 2);
+                    *l += c;
+                    report(sink, c, depth, weights);
+                }
+            }
+            *throughput *= weight;
+            Some(o + d * t)
+        }
+    }
+}
+
+/// Light sampled from the point `p` inside the current medium, which scatters light arriving
+/// along `-wi` into `-d` with its Henyey–Greenstein phase function; weighted against phase
+/// sampling by the power heuristic.
+#[inline]
+fn sample_emitter_in_medium(scene: &RenderScene, ctx: &mut Ctx, p: Vec3, d: Vec3) -> Vec3 {
+    let uc = ctx.sampler.next_1d();
+    let u = ctx.sampler.next_2d();
+    let (light, rec, weight) = scene.sample_light(p, uc, u);
+    if weight == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let f = medium::henyey_greenstein(ctx.medium.g, d.dot(rec.wi));
+    if f <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let tr = if scene.casts_shadow(light) {
+        scene.transmittance(ctx, p, Vec3::ZERO, &rec)
+    } else {
+        Vec3::ONE
+    };
+    let w = if scene.light_uses_mis(light) {
+        mis_weight(rec.pdf, f)
+    } else {
+        1.0
+    };
+    weight * f * w * tr
+}
+
+/// A direction scattered at a point of the current medium for a ray that travelled along
+/// `d`, with its density per steradian; leaves the ray's Light Path bits in the context.
+#[inline]
+fn scatter_in_medium(ctx: &mut Ctx, d: Vec3) -> (Vec3, f32) {
+    ctx.ray_flags = ray::VOLUME;
+    medium::sample_henyey_greenstein(ctx.medium.g, d, ctx.sampler.next_2d())
 }
 
 /// Russian roulette: returns false to terminate, else rescales `throughput`.
@@ -101,14 +186,27 @@ impl PathMats {
         let mut min_ray_pdf = f32::INFINITY;
         ctx.blur = 0.0;
         ctx.walks_subsurface = true;
-        ctx.medium = Vec3::ZERO;
+        ctx.medium = scene.camera_medium;
         loop {
-            // Inside an absorbing interior the segment's length is needed: no shortcut.
-            let last = depth >= end && ctx.medium == Vec3::ZERO;
-            let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
-            if ctx.medium != Vec3::ZERO {
-                throughput *= absorbed_along(ctx.medium, hit.as_ref());
-            }
+            // Inside an interior the segment's length is needed: no shortcut.
+            let last = depth >= end && ctx.medium.is_clear();
+            let (hit, mut emitted, mut lights) =
+                trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
+            let scattered = if ctx.medium.is_clear() {
+                None
+            } else {
+                through_medium(
+                    &self.paths,
+                    scene,
+                    ctx,
+                    (o, d, depth, f32::INFINITY),
+                    hit.as_ref(),
+                    &mut emitted,
+                    &mut lights,
+                    &mut throughput,
+                    (&mut l, sink, &weights),
+                )
+            };
             let direct = depth <= 2;
             if let Some((_, le, _)) = emitted {
                 let c = self.paths.clamp(throughput * le, direct);
@@ -119,6 +217,21 @@ impl PathMats {
                 let c = self.paths.clamp(throughput * lights, direct);
                 l += c;
                 report(sink, c, depth, &weights);
+            }
+            if let Some(p) = scattered {
+                if depth >= end || !roulette(ctx, depth, &mut throughput) {
+                    return l;
+                }
+                if S::ACTIVE && depth == 1 {
+                    weights = ClassWeights::DIFFUSE;
+                }
+                let (wo, _) = scatter_in_medium(ctx, d);
+                if counts.count(ctx.ray_flags, &self.paths) {
+                    end = end.min(depth + 1);
+                }
+                (o, d) = (p, wo);
+                depth += 1;
+                continue;
             }
             let Some(its) = hit else {
                 return l;
@@ -232,14 +345,26 @@ impl PathMis {
         let mut min_ray_pdf = f32::INFINITY;
         ctx.blur = 0.0;
         ctx.walks_subsurface = true;
-        ctx.medium = Vec3::ZERO;
+        ctx.medium = scene.camera_medium;
         loop {
-            // Inside an absorbing interior the segment's length is needed: no shortcut.
-            let last = depth >= end && ctx.medium == Vec3::ZERO;
-            let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, bsdf_pdf);
-            if ctx.medium != Vec3::ZERO {
-                throughput *= absorbed_along(ctx.medium, hit.as_ref());
-            }
+            // Inside an interior the segment's length is needed: no shortcut.
+            let last = depth >= end && ctx.medium.is_clear();
+            let (hit, mut emitted, mut lights) = trace_lit(scene, ctx, o, d, depth, last, bsdf_pdf);
+            let scattered = if ctx.medium.is_clear() {
+                None
+            } else {
+                through_medium(
+                    &self.paths,
+                    scene,
+                    ctx,
+                    (o, d, depth, bsdf_pdf),
+                    hit.as_ref(),
+                    &mut emitted,
+                    &mut lights,
+                    &mut throughput,
+                    (&mut l, sink, &weights),
+                )
+            };
             if let Some((e, le, erec)) = emitted {
                 let w = if bsdf_pdf.is_infinite() {
                     1.0
@@ -254,6 +379,31 @@ impl PathMis {
                 let c = self.paths.clamp(throughput * lights, depth <= 2);
                 l += c;
                 report(sink, c, depth, &weights);
+            }
+            if let Some(p) = scattered {
+                if depth >= end || !roulette(ctx, depth, &mut throughput) {
+                    return l;
+                }
+                let ls = self.paths.clamp(
+                    throughput * sample_emitter_in_medium(scene, ctx, p, d),
+                    depth == 1,
+                );
+                l += ls;
+                if S::ACTIVE && ls != Vec3::ZERO {
+                    sink.bounced(ls, &ClassWeights::DIFFUSE, depth == 1);
+                }
+                if S::ACTIVE && depth == 1 {
+                    weights = ClassWeights::DIFFUSE;
+                }
+                let (wo, pdf) = scatter_in_medium(ctx, d);
+                ctx.mis_from = None;
+                bsdf_pdf = pdf;
+                if counts.count(ctx.ray_flags, &self.paths) {
+                    end = end.min(depth + 1);
+                }
+                (o, d) = (p, wo);
+                depth += 1;
+                continue;
             }
             let Some(its) = hit else {
                 return l;

@@ -155,6 +155,13 @@ pub struct ClosureSet {
     /// Absorption coefficient σ_a per channel, 1/m (a volume's absorption closures times
     /// their weights; zero for surfaces).
     pub absorption: Vec3,
+    /// Scattering coefficient σ_s per channel, 1/m (a volume's scatter closures).
+    pub scatter: Vec3,
+    /// Sum of the scatter closures' anisotropies weighted by the mean of their σ_s.
+    pub scatter_g: f32,
+    /// Whether scatter closures of different anisotropy were added (they render as one
+    /// Henyey–Greenstein lobe of the weighted mean anisotropy).
+    pub mixed_phase: bool,
 }
 
 const EMPTY: Closure = Closure {
@@ -172,6 +179,9 @@ impl Default for ClosureSet {
             len: 0,
             emission: Vec3::ZERO,
             absorption: Vec3::ZERO,
+            scatter: Vec3::ZERO,
+            scatter_g: 0.0,
+            mixed_phase: false,
         }
     }
 }
@@ -181,6 +191,9 @@ impl ClosureSet {
         self.len = 0;
         self.emission = Vec3::ZERO;
         self.absorption = Vec3::ZERO;
+        self.scatter = Vec3::ZERO;
+        self.scatter_g = 0.0;
+        self.mixed_phase = false;
     }
 
     /// The closures present.
@@ -216,6 +229,35 @@ impl ClosureSet {
         if sigma.is_finite() {
             self.absorption += sigma.max(Vec3::ZERO);
         }
+    }
+
+    /// Adds a volume scatter closure of coefficient `sigma` (1/m) and Henyey–Greenstein
+    /// anisotropy `g`.
+    pub fn add_scatter(&mut self, sigma: Vec3, g: f32) {
+        let sigma = sigma.max(Vec3::ZERO);
+        let w = sigma.element_sum() / 3.0;
+        if !(w > 0.0 && w.is_finite() && g.is_finite()) {
+            return;
+        }
+        let before = self.scatter.element_sum() / 3.0;
+        if before > 0.0 && (self.scatter_g / before - g).abs() > 1e-4 {
+            self.mixed_phase = true;
+        }
+        self.scatter += sigma;
+        self.scatter_g += w * g;
+    }
+
+    /// The homogeneous medium of a volume's closures (emission: the emission closures, which
+    /// in a volume are radiance per metre).
+    pub fn medium(&self) -> crate::medium::Medium {
+        let w = self.scatter.element_sum() / 3.0;
+        crate::medium::Medium {
+            sigma_a: self.absorption,
+            sigma_s: self.scatter,
+            g: if w > 0.0 { self.scatter_g / w } else { 0.0 },
+            emission: self.emission,
+        }
+        .sanitized()
     }
 
     /// Chooses closure `i` with probability proportional to the mean of its weight, reusing

@@ -107,9 +107,9 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
             false,
         );
     }
-    let (absorption, volume_warnings) = match &graph.volume {
+    let (medium, volume_warnings) = match &graph.volume {
         Some((node, output)) => compile_volume(graph, material, *node, output)?,
-        None => (Vec3::ZERO, Vec::new()),
+        None => (Default::default(), Vec::new()),
     };
     let mut program = Program {
         ops: c.ops,
@@ -118,7 +118,7 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
         may_emit: c.may_emit,
         may_pass: c.may_pass,
         may_scatter_below: c.may_scatter_below,
-        absorption,
+        medium,
     };
     if !c.varying {
         // Closure operations read only constant slots: run once now.
@@ -135,15 +135,15 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
     Ok(Compiled { program, warnings })
 }
 
-/// The absorption coefficient of the volume `(node, output)` feeds into the material output's
-/// Volume, and what was reported. The interior is homogeneous: a volume whose inputs vary
-/// through space is evaluated once, at the origin, and reported.
+/// The medium of the volume `(node, output)` feeds into the material output's Volume, and what
+/// was reported. The interior is homogeneous: a volume whose inputs vary through space is
+/// evaluated once, at the origin, and reported.
 fn compile_volume(
     graph: &Graph,
     material: &str,
     node: usize,
     output: &str,
-) -> std::result::Result<(Vec3, Vec<String>), CompileError> {
+) -> std::result::Result<(crate::medium::Medium, Vec<String>), CompileError> {
     let mut c = Compiler::new(graph, material, true);
     let one = c.constant(&[1.0])?;
     c.shader_link(node, output, one)?;
@@ -160,7 +160,15 @@ fn compile_volume(
         init: c.init,
         ..Program::default()
     };
-    Ok((program.run_at_origin().absorption, c.warnings))
+    let set = program.run_at_origin();
+    let mut warnings = c.warnings;
+    if set.mixed_phase {
+        warnings.push(format!(
+            "material '{material}': volume scatter closures of different anisotropy render as \
+             one lobe of their weighted mean anisotropy"
+        ));
+    }
+    Ok((set.medium(), warnings))
 }
 
 impl<'g> Compiler<'g> {

@@ -32,6 +32,9 @@ pub mod ray {
     /// Not a Light Path bit: the world is being evaluated for its importance map, which leaves
     /// out a sun disc that is sampled apart (Cycles' `PATH_RAY_IMPORTANCE_BAKE`).
     pub const IMPORTANCE_BAKE: u32 = 128;
+    /// A ray scattered inside a volume (Cycles' `PATH_RAY_VOLUME_SCATTER`; the Light Path
+    /// node's ray kinds are all false for it, as in Cycles).
+    pub const VOLUME: u32 = 256;
 }
 
 /// A surface of one object met by a local ray ([`Tracer::local_hits`]), Blender world space.

@@ -45,7 +45,8 @@ pub fn material_program(m: &Material, textures: &[Texture]) -> Compiled {
     }
     let mut c = compile(&preset::metallic_roughness(m, textures), &m.name)
         .expect("the preset graph compiles");
-    c.program.absorption = m.volume.map_or(glam::Vec3::ZERO, |v| v.absorption());
+    c.program.medium =
+        crate::medium::Medium::absorbing(m.volume.map_or(glam::Vec3::ZERO, |v| v.absorption()));
     c
 }
 

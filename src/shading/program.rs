@@ -102,9 +102,9 @@ pub struct Program {
     pub(crate) may_pass: bool,
     /// Whether a subsurface closure can come out of the program.
     pub(crate) may_scatter_below: bool,
-    /// Absorption coefficient σ_a of the mesh's interior per channel, 1/m (the material's
-    /// volume); zero: the interior is clear.
-    pub(crate) absorption: Vec3,
+    /// The medium inside meshes with this material (the material's volume); clear by
+    /// default.
+    pub(crate) medium: crate::medium::Medium,
 }
 
 impl Program {
@@ -139,12 +139,10 @@ impl Program {
         scratch.set
     }
 
-    /// Absorption coefficient σ_a of the interior of meshes with this material, per channel,
-    /// 1/m (zero: clear). Rays between entering and leaving such a mesh are attenuated by
-    /// `exp(-σ_a t)`.
+    /// The homogeneous medium inside meshes with this material ([`crate::medium`]).
     #[inline(always)]
-    pub fn absorption(&self) -> Vec3 {
-        self.absorption
+    pub fn medium(&self) -> &crate::medium::Medium {
+        &self.medium
     }
 
     /// The closures of a program that does not depend on the shading point.

@@ -141,6 +141,27 @@ pub enum ClosureParams {
         color: Slot,
         density: Slot,
     },
+    /// The Volume Scatter node: `σ_s = density · color`, Henyey–Greenstein `anisotropy`.
+    Scatter {
+        color: Slot,
+        density: Slot,
+        anisotropy: Slot,
+    },
+    /// The Principled Volume node as Cycles' `svm_node_principled_volume`: `σ_s = ρ c`,
+    /// `σ_a = ρ max(1 - c, 0) max(1 - √a, 0)` (`ρ` density, `c` colour, `a` absorption
+    /// colour), emission `strength · colour` plus `blackbody` of Stefan–Boltzmann intensity
+    /// (`σ_SB 10⁻⁶ / π · mix(1, T⁴, blackbody)`) times its tint and colour.
+    PrincipledVolume {
+        color: Slot,
+        density: Slot,
+        anisotropy: Slot,
+        absorption_color: Slot,
+        emission_color: Slot,
+        emission_strength: Slot,
+        blackbody: Slot,
+        blackbody_tint: Slot,
+        temperature: Slot,
+    },
     /// Mix Shader weights: `out1 = w (1 - clamp(fac)), out2 = w clamp(fac)`.
     MixWeights {
         fac: Slot,
@@ -442,31 +463,108 @@ impl ClosureOp {
                 let sigma = (Vec3::ONE - col(*color)).max(Vec3::ZERO) * s.f(*density).max(0.0);
                 out.add_absorption(sigma * w);
             }
+            ClosureParams::Scatter {
+                color,
+                density,
+                anisotropy,
+            } => {
+                let sigma = col(*color).max(Vec3::ZERO) * s.f(*density).max(0.0);
+                out.add_scatter(sigma * w, s.f(*anisotropy));
+            }
+            ClosureParams::PrincipledVolume {
+                color,
+                density,
+                anisotropy,
+                absorption_color,
+                emission_color,
+                emission_strength,
+                blackbody,
+                blackbody_tint,
+                temperature,
+            } => {
+                let rho = s.f(*density).max(0.0);
+                if rho > 0.0 {
+                    let c = col(*color);
+                    let a = col(*absorption_color).max(Vec3::ZERO);
+                    let sqrt_a = Vec3::new(a.x.sqrt(), a.y.sqrt(), a.z.sqrt());
+                    out.add_scatter(c.max(Vec3::ZERO) * rho * w, s.f(*anisotropy));
+                    let absorb =
+                        (Vec3::ONE - c).max(Vec3::ZERO) * (Vec3::ONE - sqrt_a).max(Vec3::ZERO);
+                    out.add_absorption(absorb * rho * w);
+                }
+                let strength = s.f(*emission_strength);
+                if strength > 0.0 {
+                    out.add_emission(col(*emission_color) * strength * w);
+                }
+                let bb = s.f(*blackbody);
+                if bb > 0.0 {
+                    let t = s.f(*temperature).max(0.0);
+                    let t4 = (t * t) * (t * t);
+                    let intensity =
+                        5.670373e-8 * 1e-6 / std::f32::consts::PI * (1.0 + bb * (t4 - 1.0));
+                    if intensity > 0.0 {
+                        let c = super::color::blackbody(t);
+                        out.add_emission(col(*blackbody_tint) * c * intensity * w);
+                    }
+                }
+            }
             ClosureParams::MixWeights { .. } => {}
         }
     }
 }
 
-/// A shader node reached from the material output's Volume: Volume Absorption is rendered
-/// (a homogeneous absorbing interior); other nodes are reported and add nothing there, as
+/// A shader node reached from the material output's Volume: Volume Absorption, Volume Scatter
+/// (Henyey–Greenstein), Principled Volume and Emission (radiance per metre) make the
+/// homogeneous medium of the interior; surface shaders are reported and add nothing there, as
 /// Cycles ignores surface closures in a volume.
 fn compile_volume_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, CompileError> {
-    match kind {
-        "ShaderNodeVolumeAbsorption" => {
-            let params = ClosureParams::Absorption {
+    let params = match kind {
+        "ShaderNodeVolumeAbsorption" => ClosureParams::Absorption {
+            color: cx.color("Color", Vec3::splat(0.8))?,
+            density: cx.float("Density", 1.0)?,
+        },
+        "ShaderNodeVolumeScatter" => {
+            match cx.prop_str("phase").unwrap_or("HENYEY_GREENSTEIN") {
+                "HENYEY_GREENSTEIN" => {}
+                p => cx.warn(&format!(
+                    "the {p} phase function renders as Henyey-Greenstein of the node's anisotropy"
+                )),
+            }
+            ClosureParams::Scatter {
                 color: cx.color("Color", Vec3::splat(0.8))?,
                 density: cx.float("Density", 1.0)?,
-            };
-            cx.emit(Op::Closure(ClosureOp { weight: w, params }), false);
+                anisotropy: cx.float("Anisotropy", 0.0)?,
+            }
         }
-        "ShaderNodeVolumeScatter" | "ShaderNodeVolumePrincipled" => {
-            cx.warn("volume scattering is not rendered yet; the volume renders clear")
+        "ShaderNodeVolumePrincipled" => {
+            // Its attribute inputs name volume grids; meshes have none, and Cycles then
+            // renders the inputs as they are, as here.
+            ClosureParams::PrincipledVolume {
+                color: cx.color("Color", Vec3::splat(0.5))?,
+                density: cx.float("Density", 1.0)?,
+                anisotropy: cx.float("Anisotropy", 0.0)?,
+                absorption_color: cx.color("Absorption Color", Vec3::ZERO)?,
+                emission_color: cx.color("Emission Color", Vec3::ONE)?,
+                emission_strength: cx.float("Emission Strength", 0.0)?,
+                blackbody: cx.float("Blackbody Intensity", 0.0)?,
+                blackbody_tint: cx.color("Blackbody Tint", Vec3::ONE)?,
+                temperature: cx.float("Temperature", 1000.0)?,
+            }
         }
+        "ShaderNodeEmission" => ClosureParams::Emission {
+            color: cx.color("Color", Vec3::ONE)?,
+            strength: cx.float("Strength", 1.0)?,
+        },
         _ if kind.starts_with("ShaderNodeBsdf") || kind == "ShaderNodeBsdfPrincipled" => {
-            cx.warn("a surface shader in the Volume input renders nothing there, as in Cycles")
+            cx.warn("a surface shader in the Volume input renders nothing there, as in Cycles");
+            return Ok(true);
         }
-        _ => cx.warn("this shader is not rendered in a volume; the volume renders clear"),
-    }
+        _ => {
+            cx.warn("this shader is not rendered in a volume; the volume renders clear");
+            return Ok(true);
+        }
+    };
+    cx.emit(Op::Closure(ClosureOp { weight: w, params }), false);
     Ok(true)
 }
 

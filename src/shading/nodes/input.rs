@@ -272,6 +272,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
                 ("Is Singular Ray", ray::SINGULAR),
                 ("Is Reflection Ray", ray::REFLECTION),
                 ("Is Transmission Ray", ray::TRANSMISSION),
+                ("Is Volume Scatter Ray", ray::VOLUME),
             ] {
                 emit(cx, id, Float, Source::RayFlag(bit))?;
             }
@@ -279,7 +280,6 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             emit(cx, "Ray Length", Float, Source::RayLength)?;
             let zero = cx.constant(&[0.0])?;
             for id in [
-                "Is Volume Scatter Ray",
                 "Diffuse Depth",
                 "Glossy Depth",
                 "Transparent Depth",
