@@ -89,6 +89,7 @@ def renderer_args(binary, gltf, settings, width, height, region, pass_names=(), 
     for option, prop in (("--diffuse-bounces", "diffuse_bounces"),
                          ("--glossy-bounces", "glossy_bounces"),
                          ("--transmission-bounces", "transmission_bounces"),
+                         ("--volume-bounces", "volume_bounces"),
                          ("--transparent-bounces", "transparent_max_bounces")):
         if hasattr(settings, prop):
             args += [option, str(getattr(settings, prop))]

@@ -42,6 +42,10 @@ class TeselaSceneSettings(bpy.types.PropertyGroup):
     transmission_bounces: IntProperty(
         name="Transmission", default=12, min=0, max=1024,
         description="Maximum number of transmission bounces, bounded by Max Depth")
+    volume_bounces: IntProperty(
+        name="Volume", default=0, min=0, max=1024,
+        description="Maximum number of volumetric scattering events (0: light scatters once "
+                    "inside a volume)")
     transparent_max_bounces: IntProperty(
         name="Transparent", default=8, min=0, max=1024,
         description="Maximum number of transparent surfaces passed straight through")

@@ -77,7 +77,7 @@ class TESELA_PT_render(bpy.types.Panel):
         col = layout.column(heading="Light Paths")
         col.prop(s, "max_depth")
         for prop in ("diffuse_bounces", "glossy_bounces", "transmission_bounces",
-                     "transparent_max_bounces"):
+                     "volume_bounces", "transparent_max_bounces"):
             col.prop(s, prop)
         col = layout.column(heading="Clamping")
         col.prop(s, "sample_clamp_direct")

@@ -43,6 +43,7 @@ def session_settings(scene, pixel_size):
             "max_depth": int(s.max_depth), "integrator": s.integrator,
             "diffuse_bounces": int(s.diffuse_bounces), "glossy_bounces": int(s.glossy_bounces),
             "transmission_bounces": int(s.transmission_bounces),
+            "volume_bounces": int(s.volume_bounces),
             "transparent_bounces": int(s.transparent_max_bounces),
             "clamp_direct": float(s.sample_clamp_direct),
             "clamp_indirect": float(s.sample_clamp_indirect),

@@ -346,6 +346,8 @@ def tesela_like_cycles(settings):
     settings.use_adaptive_sampling = settings.use_denoising = False
     settings.pixel_filter_type, settings.filter_width = "BOX", 1.0
     settings.diffuse_bounces = settings.glossy_bounces = settings.transmission_bounces = 1024
+    if hasattr(settings, "volume_bounces"):
+        settings.volume_bounces = 0  # configure_cycles' (and Cycles' default)
     settings.sample_clamp_direct = settings.sample_clamp_indirect = 0.0
     if hasattr(settings, "caustics_reflective"):
         settings.caustics_reflective = settings.caustics_refractive = True

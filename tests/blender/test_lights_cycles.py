@@ -229,6 +229,9 @@ def agrees_with_cycles(tesela_bin, tmp_path, monkeypatch, case):
     info = build()
     scene = info.scene
     scenes.configure_cycles(scene, SIZE, SIZE, spp, bounces, seed=7)
+    volume_bounces = info.notes.get("volume_bounces")  # else configure_cycles' 0
+    if volume_bounces is not None:
+        scene.cycles.volume_bounces = volume_bounces
     ref = imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
 
     scene.render.engine = "TESELA"
@@ -236,6 +239,8 @@ def agrees_with_cycles(tesela_bin, tmp_path, monkeypatch, case):
     scenes.tesela_like_cycles(t)
     t.integrator, t.samples, t.max_depth, t.seed = integrator, spp, bounces + 2, 1
     t.threads = int(os.environ.get("TESELA_TEST_THREADS", "0"))
+    if volume_bounces is not None:
+        t.volume_bounces = volume_bounces
     assert bpy.ops.render.render() == {"FINISHED"}
     assert ref[..., :3].mean() > 0.01, "the Cycles reference is black: the scene is broken"
     got = result_pixels(tmp_path)
