@@ -3,8 +3,9 @@
 //! `KHR_materials_volume` attenuation) fills its inside with a medium that absorbs, scatters
 //! (Henyey–Greenstein) and emits. Like Cycles' volume stack, a ray enters the interior when it
 //! crosses such a surface from its front (outer) side and leaves it when it crosses back;
-//! surfaces without a volume leave the current medium as it is. One level: a medium inside
-//! another is left into the clear one.
+//! surfaces without a volume leave the current medium as it is. Outside such meshes rays travel
+//! in the world's medium (its World Output's Volume; clear without one). One level: a medium
+//! inside another is left into the world's.
 //!
 //! Path segments in a scattering medium sample a free-flight distance by spectral MIS (one of
 //! the three channels' extinctions chosen, the density the mixture of the three), so chromatic
@@ -199,7 +200,7 @@ pub fn sample_henyey_greenstein(g: f32, d: Vec3, u: Vec2) -> (Vec3, f32) {
 
 /// The medium a ray is in after it meets `its` travelling along `d` and leaves along `wo`,
 /// when it was in `current` before: a crossing into a mesh with a volume (from the side its
-/// normal points to) enters its interior, a crossing out of one leaves into the clear medium,
+/// normal points to) enters its interior, a crossing out of one leaves into the world's medium,
 /// and reflections and surfaces without a volume change nothing.
 #[inline]
 pub fn after(
@@ -219,7 +220,7 @@ pub fn after(
     } else if into < 0.0 {
         *m
     } else {
-        Medium::default()
+        scene.world_medium
     }
 }
 

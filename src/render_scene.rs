@@ -257,8 +257,11 @@ pub struct RenderScene {
     passes: bool,
     /// Some material has an interior with a volume ([`crate::medium`]).
     pub absorbs: bool,
-    /// The medium the camera is in (clear unless it sits inside a mesh with a volume).
+    /// The medium the camera is in (the world's unless it sits inside a mesh with a volume).
     pub camera_medium: Medium,
+    /// The medium filling the world outside meshes with a volume (the World Output's Volume;
+    /// clear without one).
+    pub world_medium: Medium,
     /// The ray kinds (Light Path bits) some object is hidden from ([`ObjectInfo::visibility`]):
     /// rays of those kinds step over such objects' surfaces.
     hides: u32,
@@ -309,6 +312,16 @@ fn compile_programs(scene: &Scene) -> (Vec<Arc<Program>>, Vec<String>) {
         })
         .collect();
     (programs, warnings)
+}
+
+/// The medium of the world's Volume (clear without one, or when its graph does not compile:
+/// the world's emitter reports that graph's problems).
+fn world_medium(scene: &Scene) -> Medium {
+    let Some(graph) = scene.world.graph.as_ref().filter(|g| g.volume.is_some()) else {
+        return Medium::default();
+    };
+    crate::shading::compile(graph, &scene.world.name)
+        .map_or(Medium::default(), |c| *c.program.medium())
 }
 
 /// The ray kinds some world-space mesh or instance is hidden from.
@@ -509,13 +522,15 @@ impl RenderScene {
         );
         scene.warnings.extend(warnings);
         let passes = programs.iter().any(|p| p.may_pass());
-        let absorbs = programs.iter().any(|p| !p.medium().is_clear());
+        let world_medium = world_medium(&scene);
+        let absorbs = programs.iter().any(|p| !p.medium().is_clear()) || !world_medium.is_clear();
         let hides = hidden_rays(&scene);
         let mut rs = RenderScene {
             scene,
             passes,
             absorbs,
             camera_medium: Medium::default(),
+            world_medium,
             hides,
             programs,
             camera_to_world,
@@ -543,10 +558,10 @@ impl RenderScene {
     /// initialisation, from the camera's position instead of each ray's origin).
     fn camera_medium(&self) -> Medium {
         let Some(camera) = self.scene.camera.as_ref() else {
-            return Medium::default();
+            return self.world_medium;
         };
         if !self.absorbs {
-            return Medium::default();
+            return self.world_medium;
         }
         let mut ctx = Ctx::new(crate::sampler::SobolSampler::new(0, 0, 0));
         // Any direction does for a closed mesh; this one is off every axis and diagonal.
@@ -561,12 +576,12 @@ impl RenderScene {
                 return if d.dot(its.ng) > 0.0 {
                     *m
                 } else {
-                    Medium::default()
+                    self.world_medium
                 };
             }
             o = offset_origin(its.p, its.ng, d);
         }
-        Medium::default()
+        self.world_medium
     }
 
     fn set_lights(&mut self, p: LightParts) {
@@ -610,7 +625,9 @@ impl RenderScene {
         let (programs, mut warnings) = compile_programs(&self.scene);
         self.programs = programs;
         self.passes = self.programs.iter().any(|p| p.may_pass());
-        self.absorbs = self.programs.iter().any(|p| !p.medium().is_clear());
+        self.world_medium = world_medium(&self.scene);
+        self.absorbs =
+            self.programs.iter().any(|p| !p.medium().is_clear()) || !self.world_medium.is_clear();
         self.hides = hidden_rays(&self.scene);
         self.camera_medium = self.camera_medium();
         warnings.extend(self.refresh_lights());

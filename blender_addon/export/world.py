@@ -68,9 +68,7 @@ class WorldGraph(MaterialGraph):
             self.report(self.name, None, "no World Output for Cycles; the world is black")
             return graph
         graph["surface"] = self._root(out, "Surface")
-        if self._root(out, "Volume") is not None:
-            self.report(self.name, out, "volume shaders are not supported; the Volume input is "
-                        "ignored")
+        graph["volume"] = self._root(out, "Volume")
         return graph
 
 

@@ -1,7 +1,8 @@
 """Volumes (a material's Volume input) against Cycles (PyPI bpy 5.x), through the add-on: tinted
 glass whose colour deepens with thickness, a volume-only box that casts a coloured shadow, and
 scattering media: a fog box lit by a sun with a shaft of shadow through it, a Principled Volume
-ball under a point light, a room-filling fog the camera stands in, and a glowing volume."""
+ball under a point light, a room-filling fog the camera stands in, a glowing volume, a
+multiply-scattering cloud, and fog in the world lit by a spot light."""
 
 import math
 
@@ -161,6 +162,28 @@ def white_cloud():
     return scenes.SceneInfo(bpy.context.scene, "white_cloud", {"volume_bounces": 8})
 
 
+def world_fog():
+    """Fog in the world (the World Output's Volume: a Principled Volume) lit by a spot light,
+    whose cone shows in the fog, and a small area light; the sun is removed, as Cycles' world
+    fog extinguishes light from infinitely far away (and the sky behind it)."""
+    _stage()
+    bpy.data.objects.remove(bpy.data.objects["Sun"], do_unlink=True)
+    scenes.add_spot_light("Spot", (0.8, -0.4, 2.6), (0.0, 0.3, 0.0), 400.0,
+                          math.radians(40.0), blend=0.3, radius=0.05)
+    scenes.add_area_light("Panel", (-1.5, -1.0, 2.0), (0.0, 0.0, 0.5), 60.0, 0.5)
+    scenes.add_box("Block", (-0.4, -0.3, 0.0), (0.4, 0.3, 0.8),
+                   scenes.lambert("Block", (0.7, 0.3, 0.2)))
+    world = bpy.context.scene.world
+    nt = world.node_tree
+    out = next(n for n in nt.nodes if n.type == "OUTPUT_WORLD")
+    vol = nt.nodes.new("ShaderNodeVolumePrincipled")
+    vol.inputs["Color"].default_value = (0.9, 0.9, 0.85, 1.0)
+    vol.inputs["Density"].default_value = 0.12
+    vol.inputs["Anisotropy"].default_value = 0.2
+    nt.links.new(vol.outputs[0], out.inputs["Volume"])
+    return scenes.SceneInfo(bpy.context.scene, "world_fog")
+
+
 CASES = [
     ("tinted_glass", tinted_glass, 8, "path_mis", 512),
     ("absorbing_box", absorbing_box, 4, "path_mis", 512),
@@ -169,6 +192,7 @@ CASES = [
     ("camera_in_fog", camera_in_fog, 4, "path_mis", 512),
     ("glowing_volume", glowing_volume, 4, "path_mis", 1024),
     ("white_cloud", white_cloud, 12, "path_mis", 512),
+    ("world_fog", world_fog, 4, "path_mis", 512),
 ]
 
 
