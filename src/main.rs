@@ -786,7 +786,7 @@ fn run_pipe(args: &RenderArgs) -> ExitCode {
         tile_count: rw.div_ceil(ts) * rh.div_ceil(ts),
         passes,
     });
-    let subsurface = tesela::integrator::subsurface_warning(&opts.integrator, &rscene);
+    let subsurface = tesela::integrator::limitations(&opts.integrator, &rscene);
     for w in (rscene.scene.warnings.iter())
         .chain(&denoise_warning)
         .chain(&subsurface)
@@ -953,7 +953,7 @@ fn run_render(args: &RenderArgs) -> ExitCode {
     let key = split.as_ref().map(|_| render_key(args, &opts));
     let build = std::time::Instant::now();
     let rscene = prepare(scene, light_choice(args), opts.threads);
-    let subsurface = tesela::integrator::subsurface_warning(&opts.integrator, &rscene);
+    let subsurface = tesela::integrator::limitations(&opts.integrator, &rscene);
     for w in rscene.scene.warnings.iter().chain(&subsurface) {
         eprintln!("tesela: warning: {w}");
     }

@@ -95,13 +95,23 @@ pub fn by_name_with(
     })
 }
 
-/// The warning for a render with integrator `name` of a scene with subsurface materials when
-/// that integrator does not walk them (the direct-only ones render them as diffuse).
-pub fn subsurface_warning(name: &str, scene: &RenderScene) -> Option<String> {
-    let walks = matches!(name, "path_mis" | "path_mats");
-    (!walks && scene.programs.iter().any(|p| p.may_scatter_below())).then(|| {
-        format!("subsurface scattering renders as diffuse with the {name} integrator (path_mis and path_mats walk it)")
-    })
+/// What a render with integrator `name` leaves out of `scene`: the direct-only integrators
+/// render subsurface materials as diffuse and leave volumes out (path_mis and path_mats render
+/// both).
+pub fn limitations(name: &str, scene: &RenderScene) -> Vec<String> {
+    let mut out = Vec::new();
+    if matches!(name, "path_mis" | "path_mats") {
+        return out;
+    }
+    if scene.programs.iter().any(|p| p.may_scatter_below()) {
+        out.push(format!("subsurface scattering renders as diffuse with the {name} integrator (path_mis and path_mats walk it)"));
+    }
+    if scene.absorbs {
+        out.push(format!(
+            "volumes are not rendered by the {name} integrator (path_mis and path_mats render them)"
+        ));
+    }
+    out
 }
 
 /// Most transparent surfaces a path or shadow ray goes straight through (Cycles' default
