@@ -296,19 +296,39 @@ def corner_uvs(mesh, n_loops):
     return corner_uv(layers[0], n_loops) if layers else None
 
 
+def light_is_portal(light):
+    """Whether an area light is a Cycles portal (light.cycles.is_portal, 2.8-5.x)."""
+    return bool(getattr(getattr(light, "cycles", None), "is_portal", False))
+
+
+def light_linking_used(obj):
+    """Whether an emitter object links its light or shadow to a collection (4.0+)."""
+    link = getattr(obj, "light_linking", None)
+    return link is not None and (getattr(link, "receiver_collection", None) is not None
+                                 or getattr(link, "blocker_collection", None) is not None)
+
+
 def color_layers(mesh):
     """Colour attributes (3.2+ color_attributes; legacy vertex_colors before), the render one
     first: a list of (name, domain, collection of elements with a linear 'color')."""
     attrs = getattr(mesh, "color_attributes", None)
     if attrs is not None:
-        items = [a for a in attrs if a.domain in ("CORNER", "POINT")]
+        items = [a for a in attrs if a.domain in ("CORNER", "POINT", "FACE")]
         first = getattr(attrs, "default_color_name", None)
         if first is None:
             render = getattr(attrs, "render_color_index", -1)
             all_attrs = list(attrs)
             first = all_attrs[render].name if 0 <= render < len(all_attrs) else None
         items.sort(key=lambda a: a.name != first)  # stable: the render one first
-        return [(a.name, a.domain, a.data) for a in items]
+        out = [(a.name, a.domain, a.data) for a in items]
+        # Colours on faces are generic attributes, not colour attributes; Cycles' Attribute
+        # node reads them by name all the same.
+        seen = {a.name for a in items}
+        for a in getattr(mesh, "attributes", ()):
+            if (a.domain == "FACE" and a.data_type in ("FLOAT_COLOR", "BYTE_COLOR")
+                    and a.name not in seen and not a.name.startswith(".")):
+                out.append((a.name, "FACE", a.data))
+        return out
     vcols = getattr(mesh, "vertex_colors", None)
     if vcols is None:
         return []

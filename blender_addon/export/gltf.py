@@ -236,6 +236,9 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             cached = object_mesh(obj)
             if cached is None:
                 continue
+            if compat.light_linking_used(obj):
+                warnings.append("object '%s': light linking is not rendered; its emission "
+                                "lights and shadows every object" % obj.name)
             for flag, what in (("is_shadow_catcher", "a shadow catcher"),
                                ("is_holdout", "a holdout")):
                 if getattr(obj, flag, False):
@@ -254,7 +257,15 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                 skipped_types.add(otype)
                 warnings.append("%s objects are not supported; '%s' (and any others) left out"
                                 % (otype.lower(), obj.name))
+        elif otype == "LIGHT" and compat.light_is_portal(obj.data):
+            # A portal only guides Cycles' sampling of the world through a window: it emits
+            # nothing, and Tesela samples the world without it.
+            warnings.append("light '%s' is a portal: left out (Cycles uses portals only to "
+                            "sample the world; Tesela samples it without them)" % obj.name)
         elif otype == "LIGHT":
+            if compat.light_linking_used(obj):
+                warnings.append("light '%s': light linking is not rendered; it lights and "
+                                "shadows every object" % obj.name)
             ext, khr = convert_light(obj.data, obj, matrix(inst.matrix_world), warnings)
             node = {"name": obj.name, "matrix": gltf_matrix(matrix(inst.matrix_world)),
                     "extensions": {"TESELA_light": ext}}
@@ -268,6 +279,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
 
     res.instanced_nodes = collapse(doc, root_nodes, buf, mesh_nodes, used_ext)
 
+    if getattr(scene.render, "use_motion_blur", False):
+        warnings.append("motion blur is not rendered; objects render at the frame's instant")
     cam = camera if camera is not None else scene.camera
     if cam is not None and cam.type == "CAMERA":
         r = scene.render
@@ -344,8 +357,8 @@ def render_size(render):
 def border_region(render, width, height):
     """The border as (x, y, w, h), top-left origin, or None for the full frame.
 
-    Blender's render result for a border is trunc((max - min) * size) pixels wide (measured
-    with Blender 3.4 and 5.0), placed at trunc(min * size).
+    Blender's render result for a border spans pixels trunc(min * size) to trunc(max * size)
+    (Blender 5.0: a border of 0.2-0.6 on 64 pixels is 26 wide, not trunc(0.4 * 64) = 25).
     """
     if not render.use_border:
         return None
@@ -355,8 +368,8 @@ def border_region(render, width, height):
     bx1, by1 = min(1.0, bx1), min(1.0, by1)
     xmin = int(bx0 * width)
     ymin = int(by0 * height)
-    w = int((bx1 - bx0) * width)
-    h = int((by1 - by0) * height)
+    w = int(bx1 * width) - xmin
+    h = int(by1 * height) - ymin
     w = max(1, min(w, width - xmin))
     h = max(1, min(h, height - ymin))
     if (xmin, ymin, w, h) == (0, 0, width, height):

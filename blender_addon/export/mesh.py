@@ -111,13 +111,18 @@ def read_mesh(mesh, check_cancel=None, phases=None):
     checkpoint()
     with phases("colors"):
         for name, domain, data in compat.color_layers(mesh):
-            n = n_loops if domain == "CORNER" else n_verts
+            n = {"CORNER": n_loops, "POINT": n_verts, "FACE": n_polys}[domain]
             col = np.empty(n * 4, dtype=np.float32)
             try:
                 data.foreach_get("color", col)
             except (TypeError, RuntimeError, AttributeError):
                 continue
-            raw.colors.append((name, col.reshape(-1, 4), domain))
+            col = col.reshape(-1, 4)
+            if domain == "FACE":
+                # Each corner takes its face's colour (faces' corners are consecutive).
+                sizes = np.diff(np.append(raw.loop_start, n_loops))
+                col, domain = np.repeat(col, sizes, axis=0), "CORNER"
+            raw.colors.append((name, col, domain))
     checkpoint()
     raw.texspace = compat.texture_space(mesh)
     return raw

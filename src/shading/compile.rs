@@ -446,6 +446,14 @@ impl<'g> NodeCx<'_, 'g> {
         matches!(self.node().input(id), Some(Input::Link { .. }))
     }
 
+    /// The first component of input `id`'s constant, when it has one (not linked, given).
+    pub fn input_f32(&self, id: &str) -> Option<f32> {
+        match self.node().input(id) {
+            Some(Input::Const(v)) => v.first().copied(),
+            _ => None,
+        }
+    }
+
     /// Vector input `id` when it is linked (inputs such as Normal whose unlinked value is the
     /// shading point's own, not the socket's constant); `None` when unlinked.
     pub fn linked_vector(&mut self, id: &str) -> Result<Option<Slot>> {

@@ -51,7 +51,8 @@ def parse_args(argv):
                    "--seed", "--threads", "--pipe-version", "--passes", "--adaptive-threshold",
                    "--adaptive-min-samples", "--time-limit", "--denoise-prefilter", "--filter",
                    "--filter-width", "--diffuse-bounces", "--glossy-bounces",
-                   "--transmission-bounces", "--transparent-bounces", "--clamp-direct",
+                   "--transmission-bounces", "--volume-bounces", "--transparent-bounces",
+                   "--clamp-direct",
                    "--clamp-indirect", "--blur-glossy", "--tile-size"):
             opts[a[2:].replace("-", "_")] = argv[i + 1]
             i += 2

@@ -320,7 +320,8 @@ def test_render_pixels_orientation_and_percentage(addon, fake, private_tmp, tmp_
     assert not pid_alive(run["pid"])
 
 
-@pytest.mark.parametrize("border", [(0.25, 0.75, 0.1, 0.5), (0.13, 0.61, 0.37, 0.93)])
+@pytest.mark.parametrize("border", [(0.25, 0.75, 0.1, 0.5), (0.13, 0.61, 0.37, 0.93),
+                                    (0.2, 0.6, 0.2, 0.6)])
 def test_render_border(addon, fake, private_tmp, tmp_path, border):
     scene = simple_scene(width=64, height=48, percentage=50)
     r = scene.render
@@ -330,8 +331,10 @@ def test_render_border(addon, fake, private_tmp, tmp_path, border):
     px = result_pixels(tmp_path)
     W, H = 32, 24
     assert px.shape == (H, W, 4)
-    # Blender's border: trunc((max - min) * size) pixels at trunc(min * size) (bottom-up).
-    bw, bh = int((border[1] - border[0]) * W), int((border[3] - border[2]) * H)
+    # Blender's border: pixels trunc(min * size) to trunc(max * size) (bottom-up), as Cycles
+    # fills them (0.1-0.5 of 24 rows is 10 rows, not trunc(0.4 * 24) = 9).
+    bw = int(border[1] * W) - int(border[0] * W)
+    bh = int(border[3] * H) - int(border[2] * H)
     x0, x1 = int(border[0] * W), int(border[0] * W) + bw
     y1 = H - int(border[2] * H)  # rows top to bottom
     y0 = y1 - bh

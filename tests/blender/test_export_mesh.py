@@ -81,9 +81,13 @@ def _reference(mesh, tangent_uv=None):
         uv = uv.reshape(-1, 2)
         uv[:, 1] = 1.0 - uv[:, 1]
         ref["TEXCOORD_%d" % i] = uv
+    loop_face = np.empty(nl, dtype=np.int32)
+    for f in mesh.polygons:
+        loop_face[f.loop_start:f.loop_start + f.loop_total] = f.index
     for i, (_, domain, data) in enumerate(compat.color_layers(mesh)):
         col = np.array([tuple(c.color) for c in data], dtype=np.float32)
-        ref["COLOR_%d" % i] = col if domain == "CORNER" else col[lv]
+        ref["COLOR_%d" % i] = (col if domain == "CORNER" else col[loop_face]
+                               if domain == "FACE" else col[lv])
     if tangent_uv is not None:
         mesh.calc_tangents(uvmap=tangent_uv)
         t = np.empty(nl * 3, dtype=np.float32)
@@ -152,6 +156,17 @@ def test_uv_seam_and_materials(clean):
     distinct = {(int(v), tuple(uv[c].vector)) for c, v in enumerate(lv)}
     assert len(me.vertices) < data.positions.shape[0] <= len(distinct) + len(me.vertices) // 4
     assert data.positions.shape[0] < len(me.loops)
+
+
+def test_face_colours_reach_every_corner_of_their_face(clean):
+    me = _sphere("Tiles")
+    face = me.attributes.new("Tiles", "FLOAT_COLOR", "FACE")  # not a colour attribute
+    rgba = np.random.default_rng(5).random((len(me.polygons), 4)).astype(np.float32)
+    face.data.foreach_set("color", rgba.reshape(-1))
+    byte = me.attributes.new("Bytes", "BYTE_COLOR", "FACE")
+    byte.data.foreach_set("color", rgba[::-1].copy().reshape(-1))
+    data = _assert_same_corners(me)
+    assert len(data.color_sets) == 2
 
 
 def test_flat_shading(clean):

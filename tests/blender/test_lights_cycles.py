@@ -308,3 +308,36 @@ def test_light_node_trees_are_read_or_reported(addon, tmp_path):  # noqa: F811
     light = next(n["extensions"]["TESELA_light"] for n in doc["nodes"] if n["name"] == "Lamp")
     assert light["color"] == pytest.approx([1.5, 3.0, 1.5])
     assert any("light 'Lamp'" in w and tex.name in w for w in res.warnings), res.warnings
+
+
+def test_portals_are_left_out_and_light_linking_and_motion_blur_reported(addon, tmp_path):  # noqa: F811
+    """A Cycles portal only guides world sampling: it is not exported as a light (it would
+    emit), and says so; light linking and motion blur, which Tesela does not render, are
+    reported naming the light."""
+    import json
+
+    from blender_addon import export
+
+    scenes.clear_scene()
+    portal = scenes.add_area_light("Window", (0, -2, 1.5), (0, 0, 1.5), 10.0, 1.0)
+    portal.data.cycles.is_portal = True
+    lamp = scenes.add_point_light("Lamp", (0, 0, 1), 10.0)
+    box = scenes.add_box("Box", (-0.5, -0.5, 0.0), (0.5, 0.5, 1.0), scenes.lambert("W", (0.8,) * 3))
+    if hasattr(lamp, "light_linking"):
+        coll = bpy.data.collections.new("Lit")
+        coll.objects.link(box)
+        lamp.light_linking.receiver_collection = coll
+    bpy.context.scene.render.use_motion_blur = True
+    try:
+        dg = bpy.context.evaluated_depsgraph_get()
+        path = tmp_path / "p.gltf"
+        res = export.write_gltf(dg, str(path), width=8, height=8)
+    finally:
+        bpy.context.scene.render.use_motion_blur = False
+    doc = json.loads(path.read_text(encoding="utf-8"))
+    lights = [n["name"] for n in doc["nodes"] if "TESELA_light" in n.get("extensions", {})]
+    assert lights == ["Lamp"]
+    assert any("light 'Window' is a portal" in w for w in res.warnings), res.warnings
+    assert any("motion blur is not rendered" in w for w in res.warnings), res.warnings
+    if hasattr(lamp, "light_linking"):
+        assert any("light 'Lamp': light linking" in w for w in res.warnings), res.warnings

@@ -345,6 +345,19 @@ def colour_triangle(mat):
     return ob
 
 
+def colour_tiles(mat):
+    """A 3 x 3 grid of quads covering the view with a colour per face: "Tiles", a generic
+    FLOAT_COLOR attribute on the FACE domain (not a colour attribute; Attribute nodes read it)."""
+    verts = [(-1.125 + 0.75 * i, -1.125 + 0.75 * j, 0.0) for j in range(4) for i in range(4)]
+    faces = [(j * 4 + i, j * 4 + i + 1, (j + 1) * 4 + i + 1, (j + 1) * 4 + i)
+             for j in range(3) for i in range(3)]
+    ob = mesh_object("Tiles", verts, faces, mat)
+    tiles = ob.data.attributes.new("Tiles", "FLOAT_COLOR", "FACE")
+    tiles.data.foreach_set("color", [v for k in range(9) for v in
+                                     (0.1 + 0.1 * k, 0.9 - 0.08 * k, (k % 3) * 0.4, 1.0)])
+    return ob
+
+
 # --------------------------------------------------------------------------------------------
 # cases
 
@@ -896,6 +909,8 @@ for name, output in (("Col", "Color"), ("Col", "Fac"), ("Col", "Alpha"), ("Paint
     case("attribute-%s-%s" % (name.lower(), output.lower()),
          coord(output, "ShaderNodeAttribute", {"attribute_name": name}), geometry=colour_triangle,
          snapped=False)
+case("attribute-face-tiles", coord("Color", "ShaderNodeAttribute", {"attribute_name": "Tiles"}),
+     geometry=colour_tiles, disc=True)
 for name, output in (("Paint", "Color"), ("Col", "Color"), ("Col", "Alpha"), ("", "Color")):
     case("color_attribute-%s-%s" % (name.lower() or "default", output.lower()),
          coord(output, "ShaderNodeVertexColor", {"layer_name": name}), geometry=colour_triangle,

@@ -593,6 +593,28 @@ fn world_normal(n: Vec3, _g: &ShaderGlobals) -> Vec3 {
     }
 }
 
+/// Warns where a Glossy, Anisotropic, Glass or Refraction BSDF's distribution is one Tesela
+/// renders as GGX (Beckmann, Ashikhmin-Shirley).
+fn warn_microfacet_distribution(cx: &mut NodeCx) {
+    match cx.prop_str("distribution").unwrap_or("MULTI_GGX") {
+        "GGX" | "MULTI_GGX" | "SHARP" => {}
+        "BECKMANN" => cx.warn("the Beckmann distribution renders as GGX"),
+        "ASHIKHMIN_SHIRLEY" => cx.warn("the Ashikhmin-Shirley distribution renders as GGX"),
+        d => cx.warn(&format!("the {d} distribution renders as GGX")),
+    }
+}
+
+/// Warns where a diffuse Roughness input (Oren-Nayar) is linked or above zero: the diffuse
+/// lobe renders Lambertian.
+fn warn_oren_nayar(cx: &mut NodeCx, id: &str) {
+    let rough = cx.is_linked(id) || cx.input_f32(id).is_some_and(|r| r > 0.0);
+    if rough {
+        cx.warn(&format!(
+            "the {id} input (Oren-Nayar) is not rendered; the diffuse lobe is Lambertian"
+        ));
+    }
+}
+
 /// Warns where the subsurface method (enum property `prop`) is one Tesela renders as the
 /// plain random walk.
 fn warn_subsurface_method(cx: &mut NodeCx, prop: &str) {
@@ -654,6 +676,7 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
         "ShaderNodeBackground" => return super::environment::compile_background(cx, w),
         _ if cx.in_volume() => return compile_volume_closure(kind, cx, w),
         "ShaderNodeBsdfPrincipled" => {
+            warn_oren_nayar(cx, "Diffuse Roughness");
             let f = |cx: &mut NodeCx, id: &str, d: f32| cx.float(id, d);
             let c = |cx: &mut NodeCx, id: &str, d: Vec3| cx.color(id, d);
             let p = PrincipledSlots {
@@ -765,27 +788,36 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                 normal: normal(cx, "Normal")?,
             }
         }
-        "ShaderNodeBsdfDiffuse" => ClosureParams::Diffuse {
-            color: cx.color("Color", Vec3::splat(0.8))?,
-            normal: normal(cx, "Normal")?,
-        },
-        "ShaderNodeBsdfAnisotropic" | "ShaderNodeBsdfGlossy" => ClosureParams::Glossy {
-            color: cx.color("Color", Vec3::splat(0.8))?,
-            roughness: cx.float("Roughness", 0.5)?,
-            anisotropy: cx.float("Anisotropy", 0.0)?,
-            rotation: cx.float("Rotation", 0.0)?,
-            normal: normal(cx, "Normal")?,
-            tangent: normal(cx, "Tangent")?,
-            multiscatter: cx.prop_str("distribution").unwrap_or("MULTI_GGX") == "MULTI_GGX",
-        },
-        "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction" => ClosureParams::Glass {
-            color: cx.color("Color", Vec3::ONE)?,
-            roughness: cx.float("Roughness", 0.0)?,
-            ior: cx.float("IOR", 1.5)?,
-            normal: normal(cx, "Normal")?,
-            refraction_only: kind == "ShaderNodeBsdfRefraction",
-            multiscatter: cx.prop_str("distribution").unwrap_or("MULTI_GGX") == "MULTI_GGX",
-        },
+        "ShaderNodeBsdfDiffuse" => {
+            warn_oren_nayar(cx, "Roughness");
+            ClosureParams::Diffuse {
+                color: cx.color("Color", Vec3::splat(0.8))?,
+                normal: normal(cx, "Normal")?,
+            }
+        }
+        "ShaderNodeBsdfAnisotropic" | "ShaderNodeBsdfGlossy" => {
+            warn_microfacet_distribution(cx);
+            ClosureParams::Glossy {
+                color: cx.color("Color", Vec3::splat(0.8))?,
+                roughness: cx.float("Roughness", 0.5)?,
+                anisotropy: cx.float("Anisotropy", 0.0)?,
+                rotation: cx.float("Rotation", 0.0)?,
+                normal: normal(cx, "Normal")?,
+                tangent: normal(cx, "Tangent")?,
+                multiscatter: cx.prop_str("distribution").unwrap_or("MULTI_GGX") == "MULTI_GGX",
+            }
+        }
+        "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction" => {
+            warn_microfacet_distribution(cx);
+            ClosureParams::Glass {
+                color: cx.color("Color", Vec3::ONE)?,
+                roughness: cx.float("Roughness", 0.0)?,
+                ior: cx.float("IOR", 1.5)?,
+                normal: normal(cx, "Normal")?,
+                refraction_only: kind == "ShaderNodeBsdfRefraction",
+                multiscatter: cx.prop_str("distribution").unwrap_or("MULTI_GGX") == "MULTI_GGX",
+            }
+        }
         "ShaderNodeBsdfToon" => ClosureParams::Toon {
             color: cx.color("Color", Vec3::splat(0.8))?,
             size: cx.float("Size", 0.5)?,

@@ -227,6 +227,9 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             emit(cx, "Camera", Vector, Source::Camera)?;
             emit(cx, "Reflection", Vector, Source::Reflection)?;
             // Window coordinates need the projection: reported when used.
+            if cx.wanted() == Some("Window") {
+                cx.warn("Window coordinates are not rendered; they read as (0, 0, 0)");
+            }
             let w = cx.constant(&[0.0, 0.0, 0.0])?;
             cx.alias("Window", w, Vector);
         }
@@ -249,6 +252,13 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             emit(cx, "Incoming", Vector, Source::Incoming)?;
             emit(cx, "Parametric", Vector, Source::Parametric)?;
             emit(cx, "Backfacing", Float, Source::Backfacing)?;
+            match cx.wanted() {
+                Some("Pointiness") => cx.warn("Pointiness is not rendered; it reads as 0.5"),
+                Some("Random Per Island") => {
+                    cx.warn("Random Per Island is not rendered; it reads as 0")
+                }
+                _ => {}
+            }
             let half = cx.constant(&[0.5])?;
             cx.alias("Pointiness", half, Float);
             let zero = cx.constant(&[0.0])?;
