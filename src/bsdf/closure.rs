@@ -1,6 +1,6 @@
 //! From a shading closure to the BSDF that renders it.
 
-use super::microfacet::anisotropy;
+use super::microfacet::{ConductorFresnel, anisotropy};
 use super::sheen::Sheen;
 use super::{
     BaseLobe, BsdfInstance, Coat, DELTA_ALPHA, Dielectric, Diffuse, Layered, Mirror, Plastic,
@@ -98,6 +98,7 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
             roughness,
             anisotropy: a,
             multiscatter,
+            tint,
             ..
         } => {
             let (ax, ay) = anisotropy::glossy(*roughness, *a);
@@ -106,7 +107,12 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
             if bx.max(by) < DELTA_ALPHA {
                 BsdfInstance::Mirror(Mirror::new(*color))
             } else {
-                let l = RoughConductor::glossy(*color, ax, ay);
+                let fresnel = if *color == Vec3::ONE {
+                    ConductorFresnel::Weighted(*tint)
+                } else {
+                    ConductorFresnel::Constant(*color)
+                };
+                let l = RoughConductor::with(ax, ay, fresnel);
                 let ms = *multiscatter && ax.max(ay) >= DELTA_ALPHA;
                 BsdfInstance::RoughConductor(if ms { l.multiscatter() } else { l }.blurred(blur))
             }
@@ -116,6 +122,7 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
             roughness,
             ior,
             multiscatter,
+            tint,
         } => {
             let alpha = roughness * roughness;
             let b = blurred(alpha, blur);
@@ -126,7 +133,12 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
             } else {
                 let l = RoughDielectric::glass(Vec3::ONE, *ior, alpha);
                 let ms = *multiscatter && alpha >= DELTA_ALPHA;
-                BsdfInstance::RoughDielectric(if ms { l.multiscatter() } else { l }.blurred(blur))
+                let l = if ms {
+                    l.multiscatter().multiscatter_with_fss(*tint)
+                } else {
+                    l
+                };
+                BsdfInstance::RoughDielectric(l.blurred(blur))
             }
         }
         ClosureKind::Refraction {
@@ -377,6 +389,7 @@ mod tests {
             anisotropy,
             rotation: 0.0,
             multiscatter: true,
+            tint: Vec3::ONE,
         })
     }
 
@@ -441,6 +454,7 @@ mod tests {
             roughness: 0.0,
             ior: 1.5,
             multiscatter: true,
+            tint: Vec3::ONE,
         });
         match from_closure_blurred(&glass, 0.5, b) {
             BsdfInstance::RoughDielectric(l) => {

@@ -300,6 +300,9 @@ pub enum ConductorFresnel {
     /// A constant colour, no Fresnel: Blender's Glossy BSDF (Cycles' GGX glossy closure has
     /// `fresnel_type = NONE` and the colour as the closure weight).
     Constant(Vec3),
+    /// A reflectance of one, the colour `tint` being in the closure's weight (Blender's
+    /// Glossy BSDF): only the energy compensation sees `tint`, as its `F_ss`.
+    Weighted(Vec3),
     /// Cycles' F82-tint (Principled metallic and the Metallic BSDF's "F82" mode):
     /// `F = Schlick(F0) - b cos (1 - cos)^6`, clamped to `[0, 1]`.
     F82 { f0: Vec3, b: Vec3 },
@@ -329,7 +332,7 @@ impl ConductorFresnel {
     pub fn fss(&self) -> Vec3 {
         match *self {
             ConductorFresnel::Schlick(f0) => f0 + (Vec3::ONE - f0) / 21.0,
-            ConductorFresnel::Constant(c) => c,
+            ConductorFresnel::Constant(c) | ConductorFresnel::Weighted(c) => c,
             ConductorFresnel::F82 { f0, b } => f0 + (Vec3::ONE - f0) / 21.0 - b / 126.0,
         }
     }
@@ -340,6 +343,7 @@ impl ConductorFresnel {
         match *self {
             ConductorFresnel::Schlick(f0) => fresnel::schlick(f0, cos),
             ConductorFresnel::Constant(c) => c,
+            ConductorFresnel::Weighted(_) => Vec3::ONE,
             ConductorFresnel::F82 { f0, b } => {
                 let s = (1.0 - cos).clamp(0.0, 1.0);
                 let s5 = s * s * s * s * s;

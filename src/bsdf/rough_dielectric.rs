@@ -129,6 +129,15 @@ impl RoughDielectric {
         }
     }
 
+    /// Cycles' energy compensation ([`RoughDielectric::multiscatter`]) with `F_ss` given: the
+    /// Glass BSDF's colour, which Tesela keeps in the closure weight and Cycles in the tints.
+    pub fn multiscatter_with_fss(self, fss: Vec3) -> Self {
+        RoughDielectric {
+            multiscatter_fss: Some(fss),
+            ..self
+        }
+    }
+
     /// The energy-compensation factor for `wi` (mirrored to `wi.z > 0`) and relative index
     /// `eta`; 1 without compensation.
     #[inline]

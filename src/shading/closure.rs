@@ -88,6 +88,9 @@ pub enum ClosureKind {
         rotation: f32,
         /// Multiple-scattering GGX (energy compensation), Blender's default distribution.
         multiscatter: bool,
+        /// The node's colour, which is in the closure's weight; the energy compensation takes
+        /// it as the average reflectance `F_ss`, as Cycles' constant-Fresnel setup does.
+        tint: Vec3,
     },
     /// Dielectric reflection and refraction (Blender's Glass BSDF).
     Glass {
@@ -95,6 +98,9 @@ pub enum ClosureKind {
         roughness: f32,
         ior: f32,
         multiscatter: bool,
+        /// The node's colour, in the closure's weight: `F_ss` of the energy compensation (Cycles
+        /// takes the transmission tint).
+        tint: Vec3,
     },
     /// Dielectric refraction only (Blender's Refraction BSDF).
     Refraction {

@@ -351,6 +351,23 @@ def _sphere_stage(mat, floor=(0.5, 0.5, 0.5), world_strength=0.3, sun=3.0,
     scenes.add_camera((0.0, -2.6, 1.5), (0.0, 0.0, 0.55), fov=math.radians(40.0))
 
 
+def coloured_multiscatter(kind):
+    """A rough Multiscatter GGX ball of colour 0.5 (Glossy at roughness 1, Glass at 0.8) in a
+    bright uniform world: the energy compensation darkens it by the colour's multiple bounces
+    (Cycles' F_ss = the colour), far below what a white ball scaled by 0.5 would give."""
+    def build():
+        mat, nt, out = node_material("MultiGGX")
+        if kind == "glossy":
+            bsdf = node(nt, "ShaderNodeBsdfAnisotropic", {"distribution": "MULTI_GGX"},
+                        Color=(0.5, 0.5, 0.5, 1.0), Roughness=1.0)
+        else:
+            bsdf = node(nt, "ShaderNodeBsdfGlass", {"distribution": "MULTI_GGX"},
+                        Color=(0.6, 0.4, 0.3, 1.0), Roughness=0.8, IOR=1.45)
+        surface(nt, out, bsdf.outputs[0])
+        _sphere_stage(mat, world_strength=1.0, sun=0.0)
+    return build
+
+
 def mix_layer_weight():
     """Mix Shader of Diffuse (fac 0) and Glossy (fac 1) by Layer Weight's Facing (blend 0.4)."""
     mat, nt, out = node_material("LayerMix")
@@ -704,6 +721,8 @@ CASES = [
     ("image_tube_projection", projected_image("TUBE", coords="Generated"), 0, 64, 256),
     ("mapping_scale_rotation", mapping_image, 0, 64, 256),
     ("mix_diffuse_glossy_layer_weight", mix_layer_weight, 0, 256, 1024),
+    ("multiscatter_glossy_coloured", coloured_multiscatter("glossy"), 2, 128, 512),
+    ("multiscatter_glass_coloured", coloured_multiscatter("glass"), 6, 128, 512),
     ("add_diffuse_glossy_fresnel", add_fresnel, 0, 256, 1024),
     ("alpha_cutout_shadow", alpha_cutout, 0, 128, 512),
     ("transparent_mix_shadow", transparent_mix, 0, 128, 512),

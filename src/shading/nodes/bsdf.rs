@@ -367,6 +367,7 @@ impl ClosureOp {
                     anisotropy: s.f(*anisotropy).clamp(-1.0, 1.0),
                     rotation: s.f(*rotation),
                     multiscatter: *multiscatter,
+                    tint: col(*color).max(Vec3::ZERO),
                 },
             ),
             ClosureParams::Glass {
@@ -396,6 +397,7 @@ impl ClosureOp {
                         roughness,
                         ior,
                         multiscatter: *multiscatter,
+                        tint: color.max(Vec3::ZERO),
                     }
                 };
                 push(out, color * w, normal(*n), Vec3::ZERO, kind);
