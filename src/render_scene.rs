@@ -1050,7 +1050,7 @@ impl RenderScene {
         ctx.cast(o, d, f32::INFINITY, RayKind::Emission);
         if let Some(hit) = emissive.intersect_with(&mut ctx.trav, o, d, 0.0, f32::INFINITY) {
             let its = self.intersection(&hit, d);
-            let (e, le, rec) = self.emitted(&its, o)?;
+            let (e, le, rec) = self.emitted(&its, o, ctx.ray_flags)?;
             if le == Vec3::ZERO {
                 return None;
             }
@@ -1082,7 +1082,7 @@ impl RenderScene {
                 tr *= medium::transmittance(m.sigma_t(), t);
             }
             let (e, le, rec) = match &hit {
-                Some(its) => match self.emitted(its, o) {
+                Some(its) => match self.emitted(its, o, ctx.ray_flags) {
                     Some(x) => x,
                     None => (0, Vec3::ZERO, EmitterQueryRecord::default()),
                 },
@@ -1381,12 +1381,13 @@ impl RenderScene {
             }
     }
 
-    /// Radiance emitted by the hit surface towards `from` (the ray's origin), with the
-    /// emitter's index for MIS.
+    /// Radiance emitted by the hit surface towards `from` (the ray's origin) along a ray of
+    /// Light Path bits `flags`, with the emitter's index for MIS.
     #[inline]
-    pub fn emitted(&self, its: &Intersection, from: Vec3) -> Emitted {
+    pub fn emitted(&self, its: &Intersection, from: Vec3, flags: u32) -> Emitted {
         let e = its.emitter?;
         let mut rec = EmitterQueryRecord::between(from, its.p, its.ns, its.ng, its.uv);
+        rec.ray_flags = flags;
         rec.tri = its.tri;
         rec.bary = Vec2::new(its.b1, its.b2);
         let le = self.emitters[e as usize].eval(&self.scene, &rec);
@@ -1406,7 +1407,7 @@ impl RenderScene {
         flags: u32,
     ) -> Emitted {
         match hit {
-            Some(its) => self.emitted(its, o),
+            Some(its) => self.emitted(its, o, flags),
             None => self.background_radiance(d, o, depth, flags),
         }
     }
@@ -1780,7 +1781,7 @@ mod tests {
             let its = rs
                 .intersect(&mut ctx, ref_p, rec.wi)
                 .expect("the ray hits the light");
-            let (_, hit, _) = rs.emitted(&its, ref_p).unwrap();
+            let (_, hit, _) = rs.emitted(&its, ref_p, 0).unwrap();
             let backfacing = ng.dot(rec.wi) > 0.0;
             let expected = to_blender(-rec.wi).abs() * if backfacing { 2.0 } else { 1.0 };
             let tol = 1e-4 * expected.max_element();

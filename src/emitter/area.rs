@@ -219,6 +219,7 @@ fn radiance(
             g.i = to_blender(-rec.wi);
             g.backfacing = backfacing;
             g.ray_length = rec.dist;
+            g.ray_flags = rec.ray_flags;
             g.bump_step = rec.dist.max(1e-3) * 1e-4;
             g
         }
@@ -230,6 +231,7 @@ fn radiance(
             // No ray: a nominal metre, so an emission scaled by the ray length (Light
             // Falloff's Linear and Constant) still counts in the light choice.
             g.ray_length = 1.0;
+            g.ray_flags = 0;
             g
         }
     };

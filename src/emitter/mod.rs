@@ -51,6 +51,9 @@ pub struct EmitterQueryRecord {
     pub dist: f32,
     /// Solid-angle density of the sample (0 for delta lights).
     pub pdf: f32,
+    /// Light Path bits the emitter's shader sees: none for light sampling (as Cycles
+    /// evaluates emission for its light samples), the ray's own for a ray that hits it.
+    pub ray_flags: u32,
 }
 
 impl EmitterQueryRecord {
@@ -77,6 +80,7 @@ impl EmitterQueryRecord {
             wi: d / dist,
             dist,
             pdf: 0.0,
+            ray_flags: 0,
         }
     }
 

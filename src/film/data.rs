@@ -97,7 +97,8 @@ impl DataContext<'_> {
             };
             let want_albedo = !data_done && set.contains(Pass::DenoisingAlbedo);
             if (want_emission || want_albedo)
-                && let Some((_, le, _)) = scene.emitted(&its, o)
+                && let Some((_, le, _)) =
+                    scene.emitted(&its, o, crate::shading::globals::ray::CAMERA)
             {
                 if want_emission {
                     emission += tr * le;

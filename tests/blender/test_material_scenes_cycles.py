@@ -511,6 +511,28 @@ def emission_room():
     scenes.add_camera((0.0, -0.95, 1.0), (0.0, 1.0, 0.9), fov=math.radians(80.0))
 
 
+def emitter_hidden_from_camera():
+    """A panel whose shader is Mix(Emission, Transparent) by Light Path's Is Camera Ray, the
+    artists' way to hide a light from the camera: the camera sees through it, while light
+    sampling and bounced rays (no camera bit) see its emission and light the floor and wall."""
+    white = lambert_mat("White", (0.7, 0.7, 0.7))
+    scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)], white)
+    scenes.add_quad("Back", [(-3, 1.5, 0), (3, 1.5, 0), (3, 1.5, 3), (-3, 1.5, 3)], white)
+    scenes.add_box("Block", (-0.3, -0.2, 0.0), (0.3, 0.4, 0.5), lambert_mat("Blk", (0.6, 0.3, 0.2)))
+    mat, nt, out = node_material("HiddenPanel")
+    lp = node(nt, "ShaderNodeLightPath")
+    em = node(nt, "ShaderNodeEmission", Color=(1.0, 0.9, 0.8, 1.0), Strength=8.0)
+    tr = node(nt, "ShaderNodeBsdfTransparent")
+    mix = node(nt, "ShaderNodeMixShader", Fac=lp.outputs["Is Camera Ray"])
+    nt.links.new(em.outputs[0], mix.inputs[1])
+    nt.links.new(tr.outputs[0], mix.inputs[2])
+    surface(nt, out, mix.outputs[0])
+    scenes.add_quad("Panel", [(-0.5, -0.6, 1.3), (-0.5, 0.4, 1.3), (0.5, 0.4, 1.3),
+                              (0.5, -0.6, 1.3)], mat)
+    world(0.02)
+    scenes.add_camera((0.0, -3.0, 1.6), (0.0, 0.5, 0.6), fov=math.radians(50.0))
+
+
 def emission_light_falloff():
     """A floor and a back wall lit by a 0.6 m panel 1.2 m up whose Emission strength is a Light
     Falloff node's Linear output (strength 6, smooth 0.3): brighter with the distance each ray
@@ -732,6 +754,7 @@ CASES = [
     ("vertex_colour_second_uv", vertex_colour_uv2, 0, 64, 256),
     ("emission_image_room", emission_room, 3, 256, 2048),
     ("emission_light_falloff", emission_light_falloff, 2, 256, 1024),
+    ("emitter_hidden_from_camera", emitter_hidden_from_camera, 2, 256, 1024),
     ("principled_coat", principled_variant("coat"), 0, 256, 1024),
     ("principled_sheen", principled_variant("sheen"), 0, 256, 1024),
     ("wireframe_ball", wireframe_ball, 0, 128, 512),
