@@ -368,6 +368,24 @@ def coloured_multiscatter(kind):
     return build
 
 
+def lowpoly_smooth_specular():
+    """Smooth-shaded low-poly balls (10 x 5 and 8 x 4 faces), a mirror Glossy and a glossy
+    Principled, in a bright world over a grey floor: towards their rims the interpolated normals
+    would mirror the view below the faces, where Cycles' bump map correction (on for every
+    material by default) raises them, for interpolated normals as for mapped ones."""
+    scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
+                    lambert_mat("Floor", (0.5, 0.5, 0.5)))
+    mat, nt, out = node_material("Mirror")
+    surface(nt, out, node(nt, "ShaderNodeBsdfGlossy", Color=(0.9, 0.9, 0.9, 1.0),
+                          Roughness=0.0).outputs[0])
+    scenes.add_sphere("Low", (-0.6, 0.0, 0.5), 0.5, mat, segments=10, rings=5)
+    plastic = scenes.material("Plastic", (0.2, 0.4, 0.8), roughness=0.1)
+    scenes.add_sphere("Low2", (0.6, 0.0, 0.5), 0.5, plastic, segments=8, rings=4)
+    world(1.0, (0.9, 0.95, 1.0))
+    scenes.add_sun_light("Sun", (-0.3, 0.5, -0.8), 2.0)
+    scenes.add_camera((0.0, -3.0, 1.0), (0.0, 0.0, 0.5), fov=math.radians(45.0))
+
+
 def mix_layer_weight():
     """Mix Shader of Diffuse (fac 0) and Glossy (fac 1) by Layer Weight's Facing (blend 0.4)."""
     mat, nt, out = node_material("LayerMix")
@@ -743,6 +761,7 @@ CASES = [
     ("image_tube_projection", projected_image("TUBE", coords="Generated"), 0, 64, 256),
     ("mapping_scale_rotation", mapping_image, 0, 64, 256),
     ("mix_diffuse_glossy_layer_weight", mix_layer_weight, 0, 256, 1024),
+    ("lowpoly_smooth_specular", lowpoly_smooth_specular, 2, 256, 1024),
     ("multiscatter_glossy_coloured", coloured_multiscatter("glossy"), 2, 128, 512),
     ("multiscatter_glass_coloured", coloured_multiscatter("glass"), 6, 128, 512),
     ("add_diffuse_glossy_fresnel", add_fresnel, 0, 256, 1024),
