@@ -1455,24 +1455,33 @@ impl RenderScene {
         if !self.scene.settings.film_transparent {
             return 1.0;
         }
-        let mut tr = Vec3::ONE;
+        // `held`: the share taken out by holdouts seen through the transparent surfaces so
+        // far (Cycles' `average(holdout_weight · throughput)`).
+        let (mut tr, mut held) = (Vec3::ONE, 0.0f32);
         let mut p = o;
         for _ in 0..=MAX_TRANSPARENT {
             let Some(its) = self.trace(ctx, p, d, 1) else {
-                return (1.0 - (tr.x + tr.y + tr.z) / 3.0).clamp(0.0, 1.0);
+                return (1.0 - (tr.x + tr.y + tr.z) / 3.0 - held).clamp(0.0, 1.0);
             };
             let program = &self.programs[its.material as usize];
             if !program.may_pass() {
-                return 1.0;
+                return (1.0 - held).clamp(0.0, 1.0);
             }
             let g = self.globals(&its, d, 1, crate::shading::globals::ray::CAMERA);
-            tr *= program.transparency(&g, &self.shade_env(), &mut ctx.shade);
+            let set = program.eval(&g, &self.shade_env(), &mut ctx.shade);
+            held += (tr * set.holdout).element_sum() / 3.0;
+            tr *= set
+                .closures()
+                .iter()
+                .filter(|c| matches!(c.kind, ClosureKind::Transparent { .. }))
+                .map(|c| c.weight)
+                .sum::<Vec3>();
             if tr.max_element() <= 0.0 {
-                return 1.0;
+                return (1.0 - held).clamp(0.0, 1.0);
             }
             p = offset_origin(its.p, its.ng, d);
         }
-        1.0
+        (1.0 - held).clamp(0.0, 1.0)
     }
 
     /// Light-selection probability times the emitter's solid-angle density of `rec` — the

@@ -168,6 +168,9 @@ pub struct ClosureSet {
     /// Whether scatter closures of different anisotropy were added (they render as one
     /// Henyey–Greenstein lobe of the weighted mean anisotropy).
     pub mixed_phase: bool,
+    /// Holdout weight (Holdout closures): the share of the pixel a transparent film leaves
+    /// transparent where the camera sees the surface.
+    pub holdout: Vec3,
 }
 
 const EMPTY: Closure = Closure {
@@ -188,6 +191,7 @@ impl Default for ClosureSet {
             scatter: Vec3::ZERO,
             scatter_g: 0.0,
             mixed_phase: false,
+            holdout: Vec3::ZERO,
         }
     }
 }
@@ -200,6 +204,7 @@ impl ClosureSet {
         self.scatter = Vec3::ZERO;
         self.scatter_g = 0.0;
         self.mixed_phase = false;
+        self.holdout = Vec3::ZERO;
     }
 
     /// The closures present.
@@ -234,6 +239,12 @@ impl ClosureSet {
     pub fn add_absorption(&mut self, sigma: Vec3) {
         if sigma.is_finite() {
             self.absorption += sigma.max(Vec3::ZERO);
+        }
+    }
+
+    pub fn add_holdout(&mut self, w: Vec3) {
+        if w.is_finite() {
+            self.holdout += w.max(Vec3::ZERO);
         }
     }
 

@@ -124,10 +124,11 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
         // Closure operations read only constant slots: run once now.
         let set = program.run_at_origin();
         program.may_emit = set.emission.max_element() > 0.0;
-        program.may_pass = set
-            .closures()
-            .iter()
-            .any(|c| matches!(c.kind, super::ClosureKind::Transparent { .. }));
+        program.may_pass = set.holdout != Vec3::ZERO
+            || set
+                .closures()
+                .iter()
+                .any(|c| matches!(c.kind, super::ClosureKind::Transparent { .. }));
         program.constant = Some(set);
     }
     let mut warnings = c.warnings;

@@ -165,6 +165,30 @@ def transparent_film():
     return scene
 
 
+def holdout_film():
+    """The transparent film with holdouts: the clay ball is Mix(Clay, Holdout) at 0.6, and a
+    full Holdout box stands on the floor, in the glossy ball's reflection too; the camera sees
+    holes (alpha 0.4 and 0) where Cycles cuts them, reflections and shadows stay."""
+    scene = hdri_world()
+    clay = bpy.data.materials["Clay"]
+    nt = clay.node_tree
+    out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
+    bsdf = out.inputs["Surface"].links[0].from_node
+    hold = nt.nodes.new("ShaderNodeHoldout")
+    mix = nt.nodes.new("ShaderNodeMixShader")
+    mix.inputs["Fac"].default_value = 0.6
+    nt.links.new(bsdf.outputs[0], mix.inputs[1])
+    nt.links.new(hold.outputs[0], mix.inputs[2])
+    nt.links.new(mix.outputs[0], out.inputs["Surface"])
+    cut = bpy.data.materials.new("Cut")
+    cnt = scenes._use_nodes(cut)
+    cnt.nodes.clear()
+    cout = cnt.nodes.new("ShaderNodeOutputMaterial")
+    cnt.links.new(cnt.nodes.new("ShaderNodeHoldout").outputs[0], cout.inputs["Surface"])
+    scenes.add_box("Cutout", (-0.2, -1.2, 0.0), (0.3, -0.7, 0.6), cut)
+    return scene
+
+
 # (id, builder, Cycles max bounces, spp, film_transparent)
 CASES = [
     ("hdri", lambda: hdri_world(), 4, 256, False),
@@ -172,6 +196,7 @@ CASES = [
     ("gradient", gradient_world, 4, 256, False),
     ("light_path_backdrop", backdrop_world, 4, 256, False),
     ("film_transparent", transparent_film, 4, 256, True),
+    ("film_transparent_holdout", holdout_film, 4, 256, True),
     ("mirror_ball", lambda: mirror_ball_world(), 4, 256, False),
 ]
 

@@ -162,6 +162,8 @@ pub enum ClosureParams {
         blackbody_tint: Slot,
         temperature: Slot,
     },
+    /// The Holdout node: its weight goes to [`crate::shading::ClosureSet::holdout`].
+    Holdout,
     /// Mix Shader weights: `out1 = w (1 - clamp(fac)), out2 = w clamp(fac)`.
     MixWeights {
         fac: Slot,
@@ -510,6 +512,7 @@ impl ClosureOp {
                     }
                 }
             }
+            ClosureParams::Holdout => out.add_holdout(Vec3::splat(w)),
             ClosureParams::MixWeights { .. } => {}
         }
     }
@@ -679,6 +682,11 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
         _ if cx.in_volume() => return compile_volume_closure(kind, cx, w),
         "ShaderNodeBsdfPrincipled" => {
             warn_oren_nayar(cx, "Diffuse Roughness");
+            let coated =
+                cx.is_linked("Coat Weight") || cx.input_f32("Coat Weight").unwrap_or(0.0) > 0.0;
+            if coated && cx.is_linked("Coat Normal") {
+                cx.warn("the Coat Normal is not rendered; the coat follows the Normal input");
+            }
             let f = |cx: &mut NodeCx, id: &str, d: f32| cx.float(id, d);
             let c = |cx: &mut NodeCx, id: &str, d: Vec3| cx.color(id, d);
             let p = PrincipledSlots {
@@ -845,8 +853,10 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
             }
         }
         "ShaderNodeHoldout" => {
-            cx.warn("holdout renders as nothing (no alpha yet)");
-            return Ok(true);
+            // Black, and with a transparent film a hole in the alpha where the camera sees it
+            // (Cycles ignores holdouts on an opaque film).
+            cx.passes();
+            ClosureParams::Holdout
         }
         _ => return Ok(false),
     };
