@@ -198,11 +198,7 @@ impl ShadingPoint {
             // away from the viewer.
             n = -n;
         }
-        // Cycles' bump map correction (`maybe_ensure_valid_specular_reflection`): wherever the
-        // normal is not the geometric one (a normal or bump map, or interpolated normals of
-        // smooth shading), specular lobes reflect above the geometric surface.
-        let bent = closure.normal != Vec3::ZERO || its.ns != its.ng;
-        if bent
+        if closure.normal != Vec3::ZERO
             && matches!(
                 bsdf,
                 BsdfInstance::Mirror(_)
@@ -212,8 +208,8 @@ impl ShadingPoint {
             )
         {
             // Specular lobes (Glossy, Glass, Refraction, metallic or transmissive Principled)
-            // reflect above the geometric surface, as Cycles makes them; a transmissive lobe's
-            // normal is raised on the viewer's side.
+            // under a normal or bump map reflect above the geometric surface, as Cycles makes
+            // them; a transmissive lobe's normal is raised on the viewer's side.
             let ng = if its.ng.dot(-d) < 0.0 {
                 -its.ng
             } else {
@@ -241,7 +237,7 @@ impl ShadingPoint {
         let frame = frame_of(n);
         let glossy_frame = match &bsdf {
             BsdfInstance::Layered(l)
-                if bent
+                if closure.normal != Vec3::ZERO
                     && matches!(
                         (&l.top, &l.base),
                         (
