@@ -1470,12 +1470,7 @@ impl RenderScene {
             let g = self.globals(&its, d, 1, crate::shading::globals::ray::CAMERA);
             let set = program.eval(&g, &self.shade_env(), &mut ctx.shade);
             held += (tr * set.holdout).element_sum() / 3.0;
-            tr *= set
-                .closures()
-                .iter()
-                .filter(|c| matches!(c.kind, ClosureKind::Transparent { .. }))
-                .map(|c| c.weight)
-                .sum::<Vec3>();
+            tr *= set.transparency();
             if tr.max_element() <= 0.0 {
                 return (1.0 - held).clamp(0.0, 1.0);
             }

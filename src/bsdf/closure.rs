@@ -134,7 +134,7 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
                 let l = RoughDielectric::glass(Vec3::ONE, *ior, alpha);
                 let ms = *multiscatter && alpha >= DELTA_ALPHA;
                 let l = if ms {
-                    l.multiscatter().multiscatter_with_fss(*tint)
+                    l.multiscatter_with_fss(*tint)
                 } else {
                     l
                 };

@@ -130,7 +130,8 @@ impl RoughDielectric {
     }
 
     /// Cycles' energy compensation ([`RoughDielectric::multiscatter`]) with `F_ss` given: the
-    /// Glass BSDF's colour, which Tesela keeps in the closure weight and Cycles in the tints.
+    /// Glass BSDF's colour, which Tesela keeps in the closure weight and Cycles in the tints
+    /// (for a Glass-mode lobe; a Refraction-mode lobe has no compensation in Cycles).
     pub fn multiscatter_with_fss(self, fss: Vec3) -> Self {
         RoughDielectric {
             multiscatter_fss: Some(fss),

@@ -45,7 +45,8 @@ pub(super) fn report<S: Sink>(sink: &mut S, c: Vec3, depth: u32, w: &ClassWeight
 
 /// Applies the medium `ctx.medium` to the segment from `o` along `d` that ended at `hit`
 /// (none: it left the scene), met with `emitted` and `lights` at and before its end, for a
-/// path of `throughput` at vertex `depth`. An absorbing medium attenuates by Beer's law. In a
+/// path of `throughput` at vertex `depth`. A clear medium changes nothing; an absorbing one
+/// attenuates by Beer's law. In a
 /// scattering or emitting one ([`medium`]) the segment's emission is added to `l`, and a free
 /// flight is sampled: when it ends before `hit`, what lay beyond is dropped, the light shapes
 /// met before it are added, and the point where the light scattered is returned.
@@ -63,6 +64,9 @@ fn through_medium<S: Sink>(
     (l, sink, weights): (&mut Vec3, &mut S, &ClassWeights),
 ) -> Option<Vec3> {
     let m = ctx.medium;
+    if m.is_clear() {
+        return None;
+    }
     let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
     if !m.scatters_or_emits() {
         *throughput *= medium::transmittance(m.sigma_t(), t_hit);
@@ -192,21 +196,17 @@ impl PathMats {
             let last = depth >= end && ctx.medium.is_clear();
             let (hit, mut emitted, mut lights) =
                 trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
-            let scattered = if ctx.medium.is_clear() {
-                None
-            } else {
-                through_medium(
-                    &self.paths,
-                    scene,
-                    ctx,
-                    (o, d, depth, f32::INFINITY),
-                    hit.as_ref(),
-                    &mut emitted,
-                    &mut lights,
-                    &mut throughput,
-                    (&mut l, sink, &weights),
-                )
-            };
+            let scattered = through_medium(
+                &self.paths,
+                scene,
+                ctx,
+                (o, d, depth, f32::INFINITY),
+                hit.as_ref(),
+                &mut emitted,
+                &mut lights,
+                &mut throughput,
+                (&mut l, sink, &weights),
+            );
             let direct = depth <= 2;
             if let Some((_, le, _)) = emitted {
                 let c = self.paths.clamp(throughput * le, direct);
@@ -350,21 +350,17 @@ impl PathMis {
             // Inside an interior the segment's length is needed: no shortcut.
             let last = depth >= end && ctx.medium.is_clear();
             let (hit, mut emitted, mut lights) = trace_lit(scene, ctx, o, d, depth, last, bsdf_pdf);
-            let scattered = if ctx.medium.is_clear() {
-                None
-            } else {
-                through_medium(
-                    &self.paths,
-                    scene,
-                    ctx,
-                    (o, d, depth, bsdf_pdf),
-                    hit.as_ref(),
-                    &mut emitted,
-                    &mut lights,
-                    &mut throughput,
-                    (&mut l, sink, &weights),
-                )
-            };
+            let scattered = through_medium(
+                &self.paths,
+                scene,
+                ctx,
+                (o, d, depth, bsdf_pdf),
+                hit.as_ref(),
+                &mut emitted,
+                &mut lights,
+                &mut throughput,
+                (&mut l, sink, &weights),
+            );
             if let Some((e, le, erec)) = emitted {
                 let w = if bsdf_pdf.is_infinite() {
                     1.0

@@ -242,6 +242,15 @@ impl ClosureSet {
         }
     }
 
+    /// The straight-through transmittance: the sum of the transparent closures' weights.
+    pub fn transparency(&self) -> Vec3 {
+        self.closures()
+            .iter()
+            .filter(|c| matches!(c.kind, ClosureKind::Transparent { .. }))
+            .map(|c| c.weight)
+            .sum()
+    }
+
     pub fn add_holdout(&mut self, w: Vec3) {
         if w.is_finite() {
             self.holdout += w.max(Vec3::ZERO);

@@ -219,12 +219,7 @@ impl Program {
         if !self.may_pass {
             return Vec3::ZERO;
         }
-        let set = self.eval(g, env, scratch);
-        set.closures()
-            .iter()
-            .filter(|c| matches!(c.kind, super::ClosureKind::Transparent { .. }))
-            .map(|c| c.weight)
-            .sum()
+        self.eval(g, env, scratch).transparency()
     }
 
     /// Number of operations run per shading point (0 for constant programs).

@@ -46,23 +46,6 @@ def tinted_glass():
     return scenes.SceneInfo(bpy.context.scene, "tinted_glass")
 
 
-def absorbing_box():
-    """A box with only a volume (no surface shader: rays pass its faces) over the floor: the
-    floor seen through it and its shadow are tinted by exp(-sigma t)."""
-    _stage()
-    mat = bpy.data.materials.new("Smoke")
-    scenes._use_nodes(mat)
-    nt = mat.node_tree
-    for n in list(nt.nodes):
-        if n.type != "OUTPUT_MATERIAL":
-            nt.nodes.remove(n)
-    out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
-    _absorption(nt, out, (0.9, 0.4, 0.1), 1.2)
-    # Lifted off the floor: a face coplanar with the floor would tie with it.
-    scenes.add_box("Box", (-0.7, -0.5, 0.02), (0.7, 0.5, 1.0), mat)
-    return scenes.SceneInfo(bpy.context.scene, "absorbing_box")
-
-
 def _volume_only(name):
     """A material with only a volume (no surface), its node tree and output."""
     mat = bpy.data.materials.new(name)
@@ -76,6 +59,17 @@ def _volume_only(name):
     if hasattr(getattr(mat, "cycles", None), "homogeneous_volume"):
         mat.cycles.homogeneous_volume = True
     return mat, nt, out
+
+
+def absorbing_box():
+    """A box with only a volume (no surface shader: rays pass its faces) over the floor: the
+    floor seen through it and its shadow are tinted by exp(-sigma t)."""
+    _stage()
+    mat, nt, out = _volume_only("Smoke")
+    _absorption(nt, out, (0.9, 0.4, 0.1), 1.2)
+    # Lifted off the floor: a face coplanar with the floor would tie with it.
+    scenes.add_box("Box", (-0.7, -0.5, 0.02), (0.7, 0.5, 1.0), mat)
+    return scenes.SceneInfo(bpy.context.scene, "absorbing_box")
 
 
 def fog_box():
