@@ -25,3 +25,4 @@ pub mod session;
 pub mod shading;
 pub mod study;
 pub mod texture;
+pub mod trig;

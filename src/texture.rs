@@ -25,7 +25,7 @@ fn srgb_table() -> &'static [f32; 256] {
 }
 
 /// Texel index `i` wrapped into `0..n` by `mode`.
-#[inline]
+#[inline(always)]
 pub fn wrap(i: i64, n: u32, mode: Wrap) -> usize {
     let n = n as i64;
     if (0..n).contains(&i) {
@@ -95,7 +95,7 @@ pub fn decode(v: Vec4, srgb: bool) -> Vec4 {
 /// Closest or bilinear filtering at glTF `uv` of an image of `width × height` texels whose
 /// texel `(x, y)` (integer coordinates before any wrapping) is `fetch(x, y)`. The one filter
 /// every image lookup uses; `fetch` decides wrapping, clipping and the texel's encoding.
-#[inline]
+#[inline(always)]
 pub fn filter(
     width: u32,
     height: u32,
@@ -157,26 +157,40 @@ pub fn lookup(tex: &Texture, img: &Image, uv: Vec2, srgb: bool) -> Vec4 {
     if img.width == 0 || img.height == 0 || !uv.is_finite() {
         return Vec4::ONE;
     }
-    let at = |x: i64, y: i64| {
-        (
-            wrap(x, img.width, tex.wrap_s),
-            wrap(y, img.height, tex.wrap_t),
-        )
-    };
     if !img.float.is_empty() {
         return filter(img.width, img.height, tex.nearest, uv, |x, y| {
-            let (x, y) = at(x, y);
-            texel_f(img, x, y, srgb)
+            fetch_f(tex, img, x, y, srgb)
         });
     }
     if img.rgba8.is_empty() {
         return Vec4::ONE;
     }
     let v = filter(img.width, img.height, tex.nearest, uv, |x, y| {
-        let (x, y) = at(x, y);
-        texel(img, x, y)
+        fetch_8(tex, img, x, y)
     });
     decode(v, srgb)
+}
+
+/// The wrapped texel `(x, y)` of an 8-bit image, encoded (inlined into the filter: it runs
+/// four times per bilinear lookup).
+#[inline(always)]
+fn fetch_8(tex: &Texture, img: &Image, x: i64, y: i64) -> Vec4 {
+    texel(
+        img,
+        wrap(x, img.width, tex.wrap_s),
+        wrap(y, img.height, tex.wrap_t),
+    )
+}
+
+/// The wrapped texel `(x, y)` of a float image, linear.
+#[inline(always)]
+fn fetch_f(tex: &Texture, img: &Image, x: i64, y: i64, srgb: bool) -> Vec4 {
+    texel_f(
+        img,
+        wrap(x, img.width, tex.wrap_s),
+        wrap(y, img.height, tex.wrap_t),
+        srgb,
+    )
 }
 
 #[cfg(test)]

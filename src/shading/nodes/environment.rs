@@ -23,8 +23,10 @@ pub fn direction_to_equirectangular(d: Vec3) -> Vec2 {
     if len == 0.0 || !len.is_finite() {
         return Vec2::ZERO;
     }
-    let u = (d.y.atan2(d.x) - PI) / (-2.0 * PI);
-    let v = ((d.z / len).clamp(-1.0, 1.0).acos() - PI) / -PI;
+    // acos(z / |d|) as atan2(ρ, z): one inlined arctangent form for both angles.
+    let rho = (d.x * d.x + d.y * d.y).sqrt();
+    let u = (crate::trig::atan2(d.y, d.x) - PI) / (-2.0 * PI);
+    let v = (crate::trig::atan2(rho, d.z) - PI) / -PI;
     Vec2::new(u, v)
 }
 

@@ -1,0 +1,101 @@
+//! Inverse trigonometry for the hot direction-to-image mappings (equirectangular worlds):
+//! branch-light polynomial forms that inline, in place of libm calls that cost several
+//! times more per shading point.
+
+use std::f32::consts::{FRAC_PI_2, PI};
+
+/// Minimax coefficients of `atan(a) / a` as a polynomial in `a²` on `a ∈ [0, 1]`.
+const ATAN: [f32; 9] = [
+    0.999_999_9,
+    -0.333_325_98,
+    0.199_859_07,
+    -0.141_612_29,
+    0.104_989_47,
+    -0.072_348_59,
+    0.039_781_23,
+    -0.014_401_361,
+    0.002_456_725,
+];
+
+/// `atan2(y, x)` in radians, in `[-π, π]`, within 3.5e-7 rad (1.5 ulp of π) of the exact
+/// value for finite arguments (the sign of a zero `y` is kept, as libm does:
+/// `atan2(±0, -1) = ±π`).
+/// `atan2(0, 0)` is 0; a NaN argument gives NaN; infinite arguments give the limit angle.
+#[inline]
+pub fn atan2(y: f32, x: f32) -> f32 {
+    let (ax, ay) = (x.abs(), y.abs());
+    let (lo, hi) = (ax.min(ay), ax.max(ay));
+    let a = if hi == 0.0 {
+        0.0
+    } else if hi.is_infinite() {
+        if lo.is_infinite() { 1.0 } else { 0.0 }
+    } else {
+        lo / hi
+    };
+    let s = a * a;
+    let mut p = ATAN[8];
+    for c in ATAN[..8].iter().rev() {
+        p = p * s + c;
+    }
+    let mut r = a * p;
+    if ay > ax {
+        r = FRAC_PI_2 - r;
+    }
+    if x.is_sign_negative() {
+        r = PI - r;
+    }
+    if x.is_nan() || y.is_nan() {
+        return f32::NAN;
+    }
+    r.copysign(y)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn atan2_is_within_3e7_of_the_exact_angle_everywhere() {
+        let mut worst = 0.0f64;
+        let n = 20_000;
+        for i in 0..n {
+            // Angles around the whole circle, at radii from 1e-30 to 1e30.
+            let t = (i as f64 + 0.37) / n as f64 * std::f64::consts::TAU - std::f64::consts::PI;
+            let r = 10f64.powi((i % 61) - 30);
+            let (y, x) = ((r * t.sin()) as f32, (r * t.cos()) as f32);
+            let exact = (y as f64).atan2(x as f64);
+            worst = worst.max((atan2(y, x) as f64 - exact).abs());
+        }
+        assert!(worst < 3.5e-7, "max error {worst}");
+        for (y, x) in [(0.3f32, 0.7f32), (1.0, 1.0), (5.0, -0.001), (-2.0, -3.0)] {
+            assert!((atan2(y, x) - y.atan2(x)).abs() < 2e-7, "({y}, {x})");
+        }
+    }
+
+    #[test]
+    fn atan2_edge_cases_follow_libm() {
+        for (y, x) in [
+            (0.0f32, 0.0f32),
+            (0.0, 1.0),
+            (0.0, -1.0),
+            (-0.0, -1.0),
+            (-0.0, 1.0),
+            (1.0, 0.0),
+            (-1.0, 0.0),
+            (1.0, -0.0),
+            (f32::INFINITY, 1.0),
+            (1.0, f32::INFINITY),
+            (1.0, f32::NEG_INFINITY),
+            (-1.0, f32::NEG_INFINITY),
+            (f32::INFINITY, f32::INFINITY),
+            (f32::INFINITY, f32::NEG_INFINITY),
+        ] {
+            let (got, want) = (atan2(y, x), y.atan2(x));
+            assert!(
+                (got - want).abs() < 2e-7 && got.is_sign_negative() == want.is_sign_negative(),
+                "atan2({y}, {x}) = {got}, libm {want}"
+            );
+        }
+        assert!(atan2(f32::NAN, 1.0).is_nan() && atan2(1.0, f32::NAN).is_nan());
+    }
+}
