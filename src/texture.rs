@@ -103,20 +103,27 @@ pub fn filter(
     uv: Vec2,
     fetch: impl Fn(i64, i64) -> Vec4,
 ) -> Vec4 {
-    let x = uv.x as f64 * width as f64 - 0.5;
-    let y = uv.y as f64 * height as f64 - 0.5;
-    // Keep coordinates in a range where i64 conversion is exact.
-    let x = x.clamp(-1e9, 1e9);
-    let y = y.clamp(-1e9, 1e9);
     if nearest {
+        // Clamped to a range where the i64 conversion is exact.
+        let x = (uv.x as f64 * width as f64 - 0.5).clamp(-1e9, 1e9);
+        let y = (uv.y as f64 * height as f64 - 0.5).clamp(-1e9, 1e9);
         return fetch((x + 0.5).floor() as i64, (y + 0.5).floor() as i64);
     }
-    let (x0, y0) = (x.floor(), y.floor());
-    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
-    let (x0, y0) = (x0 as i64, y0 as i64);
+    let (x0, y0, fx, fy) = bilinear_at(width, height, uv);
     let top = fetch(x0, y0).lerp(fetch(x0 + 1, y0), fx);
     let bottom = fetch(x0, y0 + 1).lerp(fetch(x0 + 1, y0 + 1), fx);
     top.lerp(bottom, fy)
+}
+
+/// The texel `(x0, y0)` at or before glTF `uv` and the fractions `(fx, fy)` towards the next
+/// ones: the corners and weights of bilinear filtering (texel centres at half-integers;
+/// clamped to a range where the i64 conversion is exact).
+#[inline(always)]
+fn bilinear_at(width: u32, height: u32, uv: Vec2) -> (i64, i64, f32, f32) {
+    let x = (uv.x as f64 * width as f64 - 0.5).clamp(-1e9, 1e9);
+    let y = (uv.y as f64 * height as f64 - 0.5).clamp(-1e9, 1e9);
+    let (x0, y0) = (x.floor(), y.floor());
+    (x0 as i64, y0 as i64, (x - x0) as f32, (y - y0) as f32)
 }
 
 /// Cycles' cubic interpolation: a uniform cubic B-spline over the 4 × 4 texels around `uv`
@@ -157,17 +164,30 @@ pub fn lookup(tex: &Texture, img: &Image, uv: Vec2, srgb: bool) -> Vec4 {
     if img.width == 0 || img.height == 0 || !uv.is_finite() {
         return Vec4::ONE;
     }
+    let (w, h) = (img.width, img.height);
     if !img.float.is_empty() {
-        return filter(img.width, img.height, tex.nearest, uv, |x, y| {
-            fetch_f(tex, img, x, y, srgb)
-        });
+        if tex.nearest {
+            return filter(w, h, true, uv, |x, y| fetch_f(tex, img, x, y, srgb));
+        }
+        // The bilinear filter written out: the four fetches inline (a closure passed to
+        // `filter` stays a call per texel).
+        let (x0, y0, fx, fy) = bilinear_at(w, h, uv);
+        let top = fetch_f(tex, img, x0, y0, srgb).lerp(fetch_f(tex, img, x0 + 1, y0, srgb), fx);
+        let bottom =
+            fetch_f(tex, img, x0, y0 + 1, srgb).lerp(fetch_f(tex, img, x0 + 1, y0 + 1, srgb), fx);
+        return top.lerp(bottom, fy);
     }
     if img.rgba8.is_empty() {
         return Vec4::ONE;
     }
-    let v = filter(img.width, img.height, tex.nearest, uv, |x, y| {
-        fetch_8(tex, img, x, y)
-    });
+    let v = if tex.nearest {
+        filter(w, h, true, uv, |x, y| fetch_8(tex, img, x, y))
+    } else {
+        let (x0, y0, fx, fy) = bilinear_at(w, h, uv);
+        let top = fetch_8(tex, img, x0, y0).lerp(fetch_8(tex, img, x0 + 1, y0), fx);
+        let bottom = fetch_8(tex, img, x0, y0 + 1).lerp(fetch_8(tex, img, x0 + 1, y0 + 1), fx);
+        top.lerp(bottom, fy)
+    };
     decode(v, srgb)
 }
 
