@@ -1370,7 +1370,7 @@ impl RenderScene {
         c.weight
             * match c.kind {
                 ClosureKind::Principled(p) => p.base_color,
-                ClosureKind::Diffuse { color }
+                ClosureKind::Diffuse { color, .. }
                 | ClosureKind::Glossy { color, .. }
                 | ClosureKind::Glass { color, .. }
                 | ClosureKind::Refraction { color, .. }

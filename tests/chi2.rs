@@ -627,6 +627,23 @@ fn diffuse_sampling() {
 }
 
 #[test]
+fn oren_nayar_sampling() {
+    let c = Vec3::new(0.8, 0.5, 0.2);
+    for (theta, sigma) in [(20.0, 0.5f32), (75.0, 1.0)] {
+        let b = Diffuse::oren_nayar(c, sigma, c);
+        let r = check_bsdf(
+            "Oren-Nayar",
+            &b,
+            dir_at(theta),
+            &DirGrid::sphere(40, 80),
+            210,
+            sidak(SIGNIFICANCE, 2),
+        );
+        assert!((r.integral - 1.0).abs() < 1e-4);
+    }
+}
+
+#[test]
 fn rough_conductor_sampling() {
     let alphas = [0.1f32, 0.3, 0.7, 1.0];
     let thetas = [0.0, 40.0, 70.0, 88.0];

@@ -114,6 +114,12 @@ fn bsdf_sample_pdf_and_weight_agree() {
         );
     };
     run("Diffuse".into(), &Diffuse::new(c));
+    for sigma in [0.3f32, 1.0] {
+        run(
+            format!("Diffuse (Oren-Nayar) sigma={sigma}"),
+            &Diffuse::oren_nayar(c, sigma, c),
+        );
+    }
     for alpha in [0.0f32, 0.002, 0.02, 0.1, 0.4, 1.0] {
         run(
             format!("RoughConductor alpha={alpha}"),

@@ -92,7 +92,11 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
             u,
         ),
         ClosureKind::Principled(p) => principled(p, u, blur),
-        ClosureKind::Diffuse { color } => BsdfInstance::Diffuse(Diffuse::new(*color)),
+        ClosureKind::Diffuse {
+            color,
+            roughness,
+            albedo,
+        } => BsdfInstance::Diffuse(Diffuse::oren_nayar(*color, *roughness, *albedo)),
         ClosureKind::Glossy {
             color,
             roughness,
@@ -237,6 +241,9 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
     } else {
         p.base_color
     };
+    // Cycles' diffuse base: Oren–Nayar whose multiple scattering takes the base colour.
+    let rough_diffuse =
+        |albedo: Vec3| Diffuse::oren_nayar(albedo, p.diffuse_roughness, p.base_color);
     let r = p.roughness.clamp(0.0, 1.0);
     let alpha0 = r * r;
     let (ax0, ay0) = anisotropy::principled(r, p.anisotropic);
@@ -272,7 +279,7 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
                 BaseLobe::RoughConductor(if ms_aniso { l.multiscatter() } else { l }.blurred(blur))
             }
         } else if p.specular_level * p.specular_tint.max_element() <= 0.0 {
-            BaseLobe::Diffuse(Diffuse::new(diffuse))
+            BaseLobe::Diffuse(rough_diffuse(diffuse))
         } else if ax.max(ay) < DELTA_ALPHA {
             BaseLobe::Plastic(Plastic::new(
                 diffuse,
@@ -291,7 +298,7 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
             } else {
                 specular
             };
-            BaseLobe::SpecularDiffuse(Layered::new(specular.blurred(blur), Diffuse::new(diffuse)))
+            BaseLobe::SpecularDiffuse(Layered::new(specular.blurred(blur), rough_diffuse(diffuse)))
         }
     };
     let coat = (p.coat_weight > 0.0)
@@ -477,7 +484,7 @@ mod tests {
             BsdfInstance::RoughDielectric(l) => assert_eq!(l.roughness, Roughness::new(b, b)),
             other => panic!("{other:?}"),
         }
-        let diffuse = closure(ClosureKind::Diffuse { color: Vec3::ONE });
+        let diffuse = closure(ClosureKind::lambert(Vec3::ONE));
         assert_eq!(
             format!("{:?}", from_closure_blurred(&diffuse, 0.5, b)),
             format!("{:?}", from_closure(&diffuse, 0.5))

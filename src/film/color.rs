@@ -18,7 +18,7 @@ pub fn closure_colors(c: &Closure, mu: f32, backfacing: bool) -> [Vec3; 3] {
     let mut out = [Vec3::ZERO; 3];
     let mut put = |class: LightClass, v: Vec3| out[class as usize] += c.weight * v;
     match c.kind {
-        ClosureKind::Diffuse { color } | ClosureKind::Translucent { color } => {
+        ClosureKind::Diffuse { color, .. } | ClosureKind::Translucent { color } => {
             put(LightClass::Diffuse, color)
         }
         ClosureKind::Toon { color, glossy, .. } => {

@@ -32,7 +32,7 @@ pub struct DataContext<'a> {
 fn closure_albedo(c: &Closure) -> Option<Vec3> {
     let color = match c.kind {
         ClosureKind::Principled(p) => p.base_color,
-        ClosureKind::Diffuse { color }
+        ClosureKind::Diffuse { color, .. }
         | ClosureKind::Glossy { color, .. }
         | ClosureKind::Glass { color, .. }
         | ClosureKind::Refraction { color, .. }

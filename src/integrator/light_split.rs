@@ -245,7 +245,7 @@ mod tests {
                 "glossy",
             ),
             (ClosureKind::Translucent { color }, "translucent"),
-            (ClosureKind::Diffuse { color }, "diffuse"),
+            (ClosureKind::lambert(color), "diffuse"),
         ];
         let mut rng = Sampler::new(5, 0, 0);
         for (kind, name) in kinds {

@@ -36,6 +36,8 @@ pub struct Principled {
     pub subsurface_scale: f32,
     /// Henyey–Greenstein `g` inside.
     pub subsurface_anisotropy: f32,
+    /// Oren–Nayar σ of the diffuse base (0: Lambert).
+    pub diffuse_roughness: f32,
     /// Blender's Principled (F82 metals, multiple-scattering GGX, coat and sheen layers);
     /// false for glTF materials, which keep their Schlick metal and single-scattering GGX.
     pub cycles: bool,
@@ -67,6 +69,7 @@ impl Principled {
             subsurface_radius: Vec3::ONE,
             subsurface_scale: 0.0,
             subsurface_anisotropy: 0.0,
+            diffuse_roughness: 0.0,
             cycles: true,
         }
     }
@@ -76,9 +79,13 @@ impl Principled {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ClosureKind {
     Principled(Principled),
-    /// Lambert (Oren–Nayar roughness is not modelled yet).
+    /// Lambert, or Oren–Nayar where `roughness` (σ) is above zero.
     Diffuse {
         color: Vec3,
+        roughness: f32,
+        /// The clamped colour Oren–Nayar's multiple-scattering term takes (Cycles passes it
+        /// beside the weight, which carries the colour too).
+        albedo: Vec3,
     },
     /// Microfacet reflection without Fresnel (Blender's Glossy/Anisotropic BSDF).
     Glossy {
@@ -136,6 +143,17 @@ pub enum ClosureKind {
     },
 }
 
+impl ClosureKind {
+    /// A Lambertian diffuse closure of `color`.
+    pub const fn lambert(color: Vec3) -> ClosureKind {
+        ClosureKind::Diffuse {
+            color,
+            roughness: 0.0,
+            albedo: Vec3::ZERO,
+        }
+    }
+}
+
 /// A closure with its weight (the product of the mix factors above it and the node's own
 /// weight) and its shading normal.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -178,7 +196,7 @@ const EMPTY: Closure = Closure {
     normal: Vec3::Z,
     tangent: Vec3::ZERO,
     surface_normal: Vec3::ZERO,
-    kind: ClosureKind::Diffuse { color: Vec3::ZERO },
+    kind: ClosureKind::lambert(Vec3::ZERO),
 };
 
 impl Default for ClosureSet {

@@ -351,6 +351,23 @@ def _sphere_stage(mat, floor=(0.5, 0.5, 0.5), world_strength=0.3, sun=3.0,
     scenes.add_camera((0.0, -2.6, 1.5), (0.0, 0.0, 0.55), fov=math.radians(40.0))
 
 
+def oren_nayar_ball(kind):
+    """A ball of diffuse roughness 1 (Oren-Nayar with its multiple-scattering term), lit by a
+    sun from behind the camera: flat like the full moon, its rim far brighter than a
+    Lambertian ball's; a Diffuse BSDF, or the diffuse base of a Principled BSDF (roughness
+    0.5) under its specular layer."""
+    def build():
+        mat, nt, out = node_material("RoughDiffuse")
+        color = (0.8, 0.5, 0.3, 1.0)
+        if kind == "principled":
+            principled(nt, out, Base_Color=color, Roughness=0.5, Diffuse_Roughness=1.0)
+        else:
+            surface(nt, out, node(nt, "ShaderNodeBsdfDiffuse", Color=color,
+                                  Roughness=1.0).outputs[0])
+        _sphere_stage(mat, world_strength=0.1, sun=4.0, sun_dir=(0.1, 0.85, -0.5))
+    return build
+
+
 def coloured_multiscatter(kind):
     """A rough Multiscatter GGX ball of colour 0.5 (Glossy at roughness 1, Glass at 0.8) in a
     bright uniform world: the energy compensation darkens it by the colour's multiple bounces
@@ -769,6 +786,8 @@ CASES = [
     ("mix_diffuse_glossy_layer_weight", mix_layer_weight, 0, 256, 1024),
     pytest.param(("lowpoly_smooth_specular", lowpoly_smooth_specular, 2, 256, 1024),
                  marks=pytest.mark.xfail(reason=LOWPOLY_REASON, strict=False)),
+    ("oren_nayar_diffuse_ball", oren_nayar_ball("diffuse"), 2, 128, 512),
+    ("oren_nayar_principled_ball", oren_nayar_ball("principled"), 2, 128, 512),
     ("multiscatter_glossy_coloured", coloured_multiscatter("glossy"), 2, 128, 512),
     ("multiscatter_glass_coloured", coloured_multiscatter("glass"), 6, 128, 512),
     ("add_diffuse_glossy_fresnel", add_fresnel, 0, 256, 1024),

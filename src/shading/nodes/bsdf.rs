@@ -52,6 +52,7 @@ pub struct PrincipledSlots {
     subsurface_radius: Slot,
     subsurface_scale: Slot,
     subsurface_anisotropy: Slot,
+    diffuse_roughness: Slot,
     emission_color: Slot,
     emission_strength: Slot,
     cycles: bool,
@@ -88,6 +89,7 @@ pub enum ClosureParams {
     },
     Diffuse {
         color: Slot,
+        roughness: Slot,
         normal: Option<Slot>,
     },
     Glossy {
@@ -280,6 +282,7 @@ impl ClosureOp {
                     subsurface_radius: col(p.subsurface_radius),
                     subsurface_scale: s.f(p.subsurface_scale).max(0.0),
                     subsurface_anisotropy: s.f(p.subsurface_anisotropy),
+                    diffuse_roughness: s.f(p.diffuse_roughness),
                     cycles: p.cycles,
                 };
                 push(
@@ -340,14 +343,22 @@ impl ClosureOp {
                     ClosureKind::Principled(pr),
                 );
             }
-            ClosureParams::Diffuse { color, normal: n } => {
+            ClosureParams::Diffuse {
+                color,
+                roughness,
+                normal: n,
+            } => {
                 let c = col(*color);
                 push(
                     out,
                     c * w,
                     normal(*n),
                     Vec3::ZERO,
-                    ClosureKind::Diffuse { color: Vec3::ONE },
+                    ClosureKind::Diffuse {
+                        color: Vec3::ONE,
+                        roughness: s.f(*roughness),
+                        albedo: c.min(Vec3::ONE),
+                    },
                 );
             }
             ClosureParams::Glossy {
@@ -609,14 +620,20 @@ fn warn_microfacet_distribution(cx: &mut NodeCx) {
     }
 }
 
-/// Warns where a diffuse Roughness input (Oren-Nayar) is linked or above zero: the diffuse
-/// lobe renders Lambertian.
-fn warn_oren_nayar(cx: &mut NodeCx, id: &str) {
-    let rough = cx.is_linked(id) || cx.input_f32(id).is_some_and(|r| r > 0.0);
-    if rough {
-        cx.warn(&format!(
-            "the {id} input (Oren-Nayar) is not rendered; the diffuse lobe is Lambertian"
-        ));
+/// Warns where the Principled BSDF's Diffuse Roughness (Oren-Nayar) cannot show: under a
+/// mirror-smooth specular layer the diffuse base stays Lambertian.
+fn warn_smooth_oren_nayar(cx: &mut NodeCx) {
+    let rough = cx.is_linked("Diffuse Roughness")
+        || cx.input_f32("Diffuse Roughness").is_some_and(|r| r > 0.0);
+    let smooth = !cx.is_linked("Roughness")
+        && cx
+            .input_f32("Roughness")
+            .is_some_and(|r| r * r < crate::bsdf::DELTA_ALPHA);
+    if rough && smooth {
+        cx.warn(
+            "the Diffuse Roughness is not rendered under a mirror-smooth specular layer \
+             (Roughness below 0.032): the diffuse base is Lambertian",
+        );
     }
 }
 
@@ -681,7 +698,7 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
         "ShaderNodeBackground" => return super::environment::compile_background(cx, w),
         _ if cx.in_volume() => return compile_volume_closure(kind, cx, w),
         "ShaderNodeBsdfPrincipled" => {
-            warn_oren_nayar(cx, "Diffuse Roughness");
+            warn_smooth_oren_nayar(cx);
             let coated =
                 cx.is_linked("Coat Weight") || cx.input_f32("Coat Weight").unwrap_or(0.0) > 0.0;
             if coated && cx.is_linked("Coat Normal") {
@@ -714,6 +731,7 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                 subsurface_radius: cx.vector("Subsurface Radius", Vec3::new(1.0, 0.2, 0.1))?,
                 subsurface_scale: f(cx, "Subsurface Scale", 0.05)?,
                 subsurface_anisotropy: f(cx, "Subsurface Anisotropy", 0.0)?,
+                diffuse_roughness: f(cx, "Diffuse Roughness", 0.0)?,
                 emission_color: c(cx, "Emission Color", Vec3::ONE)?,
                 emission_strength: f(cx, "Emission Strength", 0.0)?,
                 cycles: !cx.prop_bool("gltf", false),
@@ -798,13 +816,11 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                 normal: normal(cx, "Normal")?,
             }
         }
-        "ShaderNodeBsdfDiffuse" => {
-            warn_oren_nayar(cx, "Roughness");
-            ClosureParams::Diffuse {
-                color: cx.color("Color", Vec3::splat(0.8))?,
-                normal: normal(cx, "Normal")?,
-            }
-        }
+        "ShaderNodeBsdfDiffuse" => ClosureParams::Diffuse {
+            color: cx.color("Color", Vec3::splat(0.8))?,
+            roughness: cx.float("Roughness", 0.0)?,
+            normal: normal(cx, "Normal")?,
+        },
         "ShaderNodeBsdfAnisotropic" | "ShaderNodeBsdfGlossy" => {
             warn_microfacet_distribution(cx);
             ClosureParams::Glossy {
