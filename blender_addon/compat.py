@@ -454,6 +454,20 @@ def ray_visibility(obj):
     return out
 
 
+def is_holdout(obj, view_layer):
+    """Whether the object renders as a holdout in `view_layer`: its own Object > Visibility >
+    Holdout or its collection's (View Layer > Holdout); `holdout_get` (2.91+) answers for the
+    original object, the plain flag for older versions."""
+    orig = getattr(obj, "original", obj) or obj
+    get = getattr(orig, "holdout_get", None)
+    if get is not None and view_layer is not None:
+        try:
+            return bool(get(view_layer=view_layer))
+        except (TypeError, RuntimeError, ReferenceError):
+            pass
+    return bool(getattr(orig, "is_holdout", False))
+
+
 def is_extension_platform():
     return VERSION >= (4, 2, 0)
 

@@ -265,6 +265,8 @@ pub struct RenderScene {
     /// The ray kinds (Light Path bits) some object is hidden from ([`ObjectInfo::visibility`]):
     /// rays of those kinds step over such objects' surfaces.
     hides: u32,
+    /// Some object is a holdout ([`ObjectInfo::holdout`]).
+    holdouts: bool,
     /// The camera in Blender's coordinates, for the graph's Camera coordinates.
     camera_to_world: Mat4,
     /// The world-space meshes.
@@ -331,6 +333,12 @@ fn hidden_rays(scene: &Scene) -> u32 {
     meshes
         .chain(instances)
         .fold(0, |h, v| h | (ObjectInfo::VISIBLE_TO_ALL & !v))
+}
+
+/// Whether some world-space mesh or instance is a holdout.
+fn any_holdout(scene: &Scene) -> bool {
+    scene.meshes.iter().any(|m| m.attrs.object.holdout)
+        || scene.instances.iter().any(|i| i.object.holdout)
 }
 
 /// What a ray scattered with the Light Path bits `flags` sees objects as (Cycles'
@@ -525,6 +533,7 @@ impl RenderScene {
         let world_medium = world_medium(&scene);
         let absorbs = programs.iter().any(|p| !p.medium().is_clear()) || !world_medium.is_clear();
         let hides = hidden_rays(&scene);
+        let holdouts = any_holdout(&scene);
         let mut rs = RenderScene {
             scene,
             passes,
@@ -532,6 +541,7 @@ impl RenderScene {
             camera_medium: Medium::default(),
             world_medium,
             hides,
+            holdouts,
             programs,
             camera_to_world,
             accel,
@@ -629,6 +639,7 @@ impl RenderScene {
         self.absorbs =
             self.programs.iter().any(|p| !p.medium().is_clear()) || !self.world_medium.is_clear();
         self.hides = hidden_rays(&self.scene);
+        self.holdouts = any_holdout(&self.scene);
         self.camera_medium = self.camera_medium();
         warnings.extend(self.refresh_lights());
         warnings
@@ -890,6 +901,16 @@ impl RenderScene {
     #[inline]
     fn sees(&self, hit: &Hit, kind: u32) -> bool {
         self.object_visibility(hit.key[0], hit.instance) & kind != 0
+    }
+
+    /// Whether the object `its` hit is a holdout ([`ObjectInfo::holdout`]).
+    #[inline]
+    fn holdout_at(&self, its: &Intersection) -> bool {
+        self.holdouts
+            && match self.scene.instances.get(its.instance as usize) {
+                Some(i) => i.object.holdout,
+                None => self.scene.meshes[its.mesh as usize].attrs.object.holdout,
+            }
     }
 
     /// [`ObjectInfo::visibility`] of world-space mesh `mesh`, or of `instance` when it is one.
@@ -1343,9 +1364,35 @@ impl RenderScene {
         depth: u32,
         u: f32,
     ) -> Option<(&'a crate::shading::Closure, f32, f32)> {
+        if depth <= 1 && self.holdout_at(its) {
+            // A holdout object keeps only its transparency for camera rays (Cycles'
+            // surface_shader_apply_holdout): the path goes on through that, or ends.
+            let t = self.closures_at(ctx, its, d, depth).transparency();
+            if t.max_element() <= 0.0 {
+                return None;
+            }
+            let set = &mut ctx.shade.set;
+            set.clear();
+            set.push_transparent(t);
+            return Some((&set.closures[0], 1.0, u));
+        }
+        let set = self.closures_at(ctx, its, d, depth);
+        let (i, p, u) = set.choose(u)?;
+        Some((&set.closures[i], 1.0 / p, u))
+    }
+
+    /// The closures of the hit's material at path vertex `depth`.
+    #[inline]
+    fn closures_at<'a>(
+        &'a self,
+        ctx: &'a mut Ctx,
+        its: &Intersection,
+        d: Vec3,
+        depth: u32,
+    ) -> &'a crate::shading::ClosureSet {
         let program = &self.programs[its.material as usize];
         // Constant materials (most of them) need no shading point at all.
-        let set = match program.constant_set() {
+        match program.constant_set() {
             Some(set) => set,
             None => {
                 let flags = if depth <= 1 {
@@ -1357,9 +1404,7 @@ impl RenderScene {
                 let env = self.shade_env();
                 program.eval(&g, &env, &mut ctx.shade)
             }
-        };
-        let (i, p, u) = set.choose(u)?;
-        Some((&set.closures[i], 1.0 / p, u))
+        }
     }
 
     /// Surface albedo at a hit (the debug view): the chosen closure's colour.
@@ -1386,6 +1431,9 @@ impl RenderScene {
     #[inline]
     pub fn emitted(&self, its: &Intersection, from: Vec3, flags: u32) -> Emitted {
         let e = its.emitter?;
+        if flags & crate::shading::globals::ray::CAMERA != 0 && self.holdout_at(its) {
+            return None;
+        }
         let mut rec = EmitterQueryRecord::between(from, its.p, its.ns, its.ng, its.uv);
         rec.ray_flags = flags;
         rec.tri = its.tri;
@@ -1464,13 +1512,21 @@ impl RenderScene {
                 return (1.0 - (tr.x + tr.y + tr.z) / 3.0 - held).clamp(0.0, 1.0);
             };
             let program = &self.programs[its.material as usize];
-            if !program.may_pass() {
+            let holdout = self.holdout_at(&its);
+            if !program.may_pass() && !holdout {
                 return (1.0 - held).clamp(0.0, 1.0);
             }
             let g = self.globals(&its, d, 1, crate::shading::globals::ray::CAMERA);
             let set = program.eval(&g, &self.shade_env(), &mut ctx.shade);
-            held += (tr * set.holdout).element_sum() / 3.0;
-            tr *= set.transparency();
+            let through = set.transparency();
+            // A holdout object holds out all but its transparency.
+            let cut = if holdout {
+                Vec3::ONE - through
+            } else {
+                set.holdout
+            };
+            held += (tr * cut).element_sum() / 3.0;
+            tr *= through;
             if tr.max_element() <= 0.0 {
                 return (1.0 - held).clamp(0.0, 1.0);
             }

@@ -239,14 +239,12 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             if compat.light_linking_used(obj):
                 warnings.append("object '%s': light linking is not rendered; its emission "
                                 "lights and shadows every object" % obj.name)
-            for flag, what in (("is_shadow_catcher", "a shadow catcher"),
-                               ("is_holdout", "a holdout")):
-                if getattr(obj, flag, False):
-                    warnings.append("object '%s' is %s; Tesela renders it as an ordinary "
-                                    "object" % (obj.name, what))
+            if getattr(obj, "is_shadow_catcher", False):
+                warnings.append("object '%s' is a shadow catcher; Tesela renders it as an "
+                                "ordinary object" % obj.name)
             mi, ntri, texspace = cached
             res.triangles += ntri
-            extras = {"tesela_object": object_extras(inst, obj)}
+            extras = {"tesela_object": object_extras(inst, obj, depsgraph.view_layer)}
             if texspace is not None:
                 extras["tesela_texspace"] = {"location": texspace[0], "size": texspace[1]}
             mesh_nodes.setdefault(mi, []).append(len(doc["nodes"]))

@@ -435,8 +435,9 @@ def random_number(rid):
     return float(np.float32(rid)) * 2.0 ** -32  # (float)0xFFFFFFFF rounds to 2^32
 
 
-def object_extras(inst, obj):
-    """extras.tesela_object: what Object Info reads (Blender's world coordinates)."""
+def object_extras(inst, obj, view_layer=None):
+    """extras.tesela_object: what Object Info reads (Blender's world coordinates), the ray
+    visibility and whether the object is a holdout (its own or its instancer's)."""
     rid = random_id(inst, obj)
     m = inst.matrix_world
     out = {"random": random_number(rid), "random_id": rid,
@@ -450,4 +451,8 @@ def object_extras(inst, obj):
         vis = {k: v and parent[k] for k, v in vis.items()}
     if not all(vis.values()):
         out["visibility"] = vis
+    parent = inst.parent if inst.is_instance else None
+    if compat.is_holdout(obj, view_layer) or (
+            parent is not None and compat.is_holdout(parent, view_layer)):
+        out["holdout"] = True
     return out

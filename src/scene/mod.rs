@@ -55,6 +55,10 @@ pub struct ObjectInfo {
     /// `TRANSMISSION` for the rays scattered by those closures, and `SHADOW` for shadow rays
     /// (off: it casts no shadow). Rays of other kinds pass through it, as in Cycles.
     pub visibility: u32,
+    /// Blender's Object > Visibility > Holdout: camera rays (straight or through transparent
+    /// surfaces) see a hole in the film where they meet the object (alpha 0 with a
+    /// transparent film, black with an opaque one); every other ray sees its material.
+    pub holdout: bool,
 }
 
 impl ObjectInfo {
@@ -74,6 +78,7 @@ impl Default for ObjectInfo {
             color: glam::Vec4::ONE,
             location: Vec3::ZERO,
             visibility: ObjectInfo::VISIBLE_TO_ALL,
+            holdout: false,
         }
     }
 }

@@ -248,6 +248,17 @@ impl ClosureSet {
         }
     }
 
+    /// Adds a straight pass-through of weight `w`.
+    pub fn push_transparent(&mut self, w: Vec3) {
+        self.push(Closure {
+            weight: w,
+            normal: Vec3::ZERO,
+            tangent: Vec3::ZERO,
+            surface_normal: Vec3::ZERO,
+            kind: ClosureKind::Transparent { color: Vec3::ONE },
+        });
+    }
+
     pub fn add_emission(&mut self, e: Vec3) {
         if e.is_finite() {
             self.emission += e.max(Vec3::ZERO);

@@ -189,6 +189,29 @@ def holdout_film():
     return scene
 
 
+def object_holdout():
+    """The clay ball is a holdout object (Object > Visibility > Holdout): the camera sees a hole
+    (black on an opaque film), the glossy ball still reflects the clay ball, which still
+    shadows the floor."""
+    scene = hdri_world()
+    bpy.data.objects["Diffuse"].is_holdout = True
+    return scene
+
+
+def collection_holdout():
+    """As object_holdout, the clay ball held out by a holdout collection of the view layer
+    (Object > Visibility > Holdout stays off)."""
+    scene = hdri_world()
+    col = bpy.data.collections.new("Held")
+    scene.collection.children.link(col)
+    ball = bpy.data.objects["Diffuse"]
+    for c in list(ball.users_collection):
+        c.objects.unlink(ball)
+    col.objects.link(ball)
+    bpy.context.view_layer.layer_collection.children["Held"].holdout = True
+    return scene
+
+
 # (id, builder, Cycles max bounces, spp, film_transparent)
 CASES = [
     ("hdri", lambda: hdri_world(), 4, 256, False),
@@ -198,6 +221,9 @@ CASES = [
     ("film_transparent", transparent_film, 4, 256, True),
     ("film_transparent_holdout", holdout_film, 4, 256, True),
     ("mirror_ball", lambda: mirror_ball_world(), 4, 256, False),
+    ("object_holdout_transparent", object_holdout, 4, 256, True),
+    ("object_holdout_opaque", object_holdout, 4, 256, False),
+    ("collection_holdout_transparent", collection_holdout, 4, 256, True),
 ]
 
 

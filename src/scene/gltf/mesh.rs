@@ -439,6 +439,11 @@ impl<'a> Loader<'a> {
                 None => bad.push("visibility"),
             },
         }
+        match member(o, "holdout").map(|v| v.as_bool()) {
+            None => {}
+            Some(Some(h)) => info.holdout = h,
+            Some(None) => bad.push("holdout"),
+        }
         if !bad.is_empty() {
             self.warn_once(format!(
                 "node {ni}: extras.tesela_object has an invalid {}; defaults are used for it",

@@ -662,6 +662,24 @@ fn object_ray_visibility_from_the_extras() {
 }
 
 #[test]
+fn object_holdout_from_the_extras() {
+    let s = load(&quad_doc(json!({}), json!({}), &[], json!({})));
+    assert!(!s.meshes[0].attrs.object.holdout);
+    let node = json!({ "extras": { "tesela_object": { "holdout": true } } });
+    let s = load(&quad_doc(json!({}), json!({}), &[], node));
+    assert!(s.meshes[0].attrs.object.holdout);
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let node = json!({ "extras": { "tesela_object": { "holdout": "yes" } } });
+    let s = load(&quad_doc(json!({}), json!({}), &[], node));
+    assert!(!s.meshes[0].attrs.object.holdout);
+    assert!(
+        s.warnings.iter().any(|w| w.contains("invalid holdout")),
+        "{:?}",
+        s.warnings
+    );
+}
+
+#[test]
 fn blender_auto_texture_space_rules() {
     use super::mesh::auto_texspace;
     let (l, s) = auto_texspace(Vec3::new(-1.0, 0.0, 2.0), Vec3::new(3.0, 0.0, 2.000001));
