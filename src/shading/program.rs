@@ -160,22 +160,26 @@ impl Program {
         // Bump nodes evaluate their height at offset points: operations between Enter and
         // Leave see the moved point.
         let mut moved: Option<ShaderGlobals> = None;
-        // A displacement rendered as bump replaces the normal the rest of the graph sees.
-        let mut base = *g;
+        // A displacement rendered as bump replaces the normal the rest of the graph sees
+        // (copied only then: most graphs read `g` as it is).
+        let mut displaced: Option<ShaderGlobals> = None;
         for op in &self.ops {
             match op {
-                Op::Bump(nodes::bump::BumpOp::Enter { axis }) => moved = Some(base.offset(*axis)),
+                Op::Bump(nodes::bump::BumpOp::Enter { axis }) => {
+                    moved = Some(displaced.as_ref().unwrap_or(g).offset(*axis))
+                }
                 Op::Bump(nodes::bump::BumpOp::Leave) => moved = None,
                 Op::Bump(nodes::bump::BumpOp::SetNormal { n }) => {
                     let v = s.v(*n);
                     if v.is_finite() && v != Vec3::ZERO {
+                        let base = displaced.get_or_insert(*g);
                         base.n = v;
                         base.n_displaced = true;
                     }
                 }
                 _ => op.eval(
                     &mut s,
-                    moved.as_ref().unwrap_or(&base),
+                    moved.as_ref().or(displaced.as_ref()).unwrap_or(g),
                     env,
                     &mut scratch.set,
                 ),

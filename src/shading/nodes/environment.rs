@@ -17,7 +17,7 @@ use std::f32::consts::PI;
 /// Blender-world direction → Cycles' equirectangular `(u, v)` (`v = 0` at the bottom of the
 /// image, `-Z`; `u = 0.5` towards `+X`, `u` growing towards `-Y`): Cycles'
 /// `direction_to_equirectangular`. A zero direction gives `(0, 0)`.
-#[inline]
+#[inline(always)]
 pub fn direction_to_equirectangular(d: Vec3) -> Vec2 {
     let len = d.length();
     if len == 0.0 || !len.is_finite() {
