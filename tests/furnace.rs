@@ -224,6 +224,29 @@ fn furnace_white_oren_nayar_is_lossless() {
 }
 
 #[test]
+fn furnace_specular_over_a_black_base_keeps_the_specular_layer() {
+    // Directions sampled from the black base still carry the specular layer's reflection:
+    // the mean weight must match the cubature of the mixture's value.
+    for alpha in [0.1f32, 0.25, 0.8] {
+        let b = Layered::new(
+            RoughDielectric::principled_specular(Vec3::ONE, 1.5, alpha, alpha).multiscatter(),
+            Diffuse::new(Vec3::ZERO),
+        );
+        for &t in &THETAS[..4] {
+            let wi = dir(t, false);
+            let e = furnace(
+                &format!("specular over black alpha={alpha} theta={t}"),
+                &b,
+                wi,
+                mirror(wi),
+                4000 + t as u64,
+            );
+            assert!(e > 0.01, "alpha {alpha}, θ {t}: E = {e}");
+        }
+    }
+}
+
+#[test]
 fn oren_nayar_is_brighter_towards_the_light_and_lambert_without_roughness() {
     let wi = dir(60.0, false);
     let lambert = Diffuse::new(Vec3::splat(0.5));

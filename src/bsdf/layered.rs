@@ -238,6 +238,12 @@ impl Layer for Sheen {
     }
 }
 
+/// Whether a lobe's `sample` left a direction with a density in `rec`, whatever its weight.
+#[inline]
+pub fn sampled_direction(rec: &BsdfQueryRecord) -> bool {
+    rec.measure == Measure::SolidAngle && rec.pdf > 0.0 && rec.pdf.is_finite()
+}
+
 /// The top lobe is chosen when `u1 < p`; `u1` is then rescaled to `[0, 1)` for the lobe.
 #[inline]
 fn pick(p: f32, u1: f32) -> (bool, f32) {
@@ -340,7 +346,9 @@ impl<T: Layer, B: Bsdf> Bsdf for Layered<T, B> {
         } else {
             self.base.sample(rec, u, u1)
         };
-        if w == Vec3::ZERO {
+        // A lobe of zero weight (a black base) may still sample a direction the mixture
+        // reflects: only a failed sample ends here.
+        if w == Vec3::ZERO && !sampled_direction(rec) {
             return Vec3::ZERO;
         }
         match rec.measure {

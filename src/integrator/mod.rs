@@ -508,7 +508,8 @@ impl ShadingPoint {
         } else {
             l.base.sample(&mut rec, u, u1)
         };
-        if w == Vec3::ZERO {
+        // The pair's weight comes from its value; a black lobe's direction still counts.
+        if w == Vec3::ZERO && !bsdf::layered::sampled_direction(&rec) {
             return None;
         }
         let wo = frame.to_world(rec.wo);
