@@ -337,6 +337,45 @@ def color_layers(mesh):
     return [(a.name, "CORNER", a.data) for a in items]
 
 
+# Blender's own mesh attributes, which no Attribute node means: not exported.
+_BUILTIN_ATTRIBUTES = frozenset((
+    "position", "sharp_face", "material_index", "sharp_edge", "custom_normal", "crease_vert",
+    "crease_edge", "bevel_weight_vert", "bevel_weight_edge", "normal", "id"))
+
+# Generic attribute types the Attribute node reads, with the components `foreach_get` gives.
+_GENERIC_TYPES = {"FLOAT": ("value", 1), "INT": ("value", 1), "INT8": ("value", 1),
+                  "BOOLEAN": ("value", 1), "FLOAT_VECTOR": ("vector", 3), "FLOAT2": ("vector", 2)}
+
+
+def generic_attributes(mesh, n_by_domain, skip):
+    """Named float, integer, boolean and vector attributes (Geometry Nodes' Store Named
+    Attribute, Python) on points, faces or corners, as the Attribute node reads them: a list
+    of (name, domain, float32 (n, 4)) with floats as (f, f, f, 1), vectors as (x, y, z, 1) and
+    2D vectors as (x, y, 0, 1), Cycles' conversions. Names in `skip` (colour attributes, UV
+    maps), internal ('.') and built-in ones are left out."""
+    out = []
+    for a in getattr(mesh, "attributes", ()):
+        kind = _GENERIC_TYPES.get(a.data_type)
+        n = n_by_domain.get(a.domain)
+        if (kind is None or n is None or a.name in skip or a.name.startswith(".")
+                or a.name in _BUILTIN_ATTRIBUTES):
+            continue
+        prop, k = kind
+        flat = np.empty(n * k, dtype=np.float32)
+        try:
+            a.data.foreach_get(prop, flat)
+        except (TypeError, RuntimeError, AttributeError):
+            continue
+        v = np.zeros((n, 4), dtype=np.float32)
+        v[:, 3] = 1.0
+        if k == 1:
+            v[:, :3] = flat[:, None]
+        else:
+            v[:, :k] = flat.reshape(n, k)
+        out.append((a.name, a.domain, v))
+    return out
+
+
 def corner_tangents(mesh, uv_name, n_loops):
     """Blender's MikkTSpace tangents for a UV map: (float32 (n, 3), float32 (n,) bitangent sign).
     Raises RuntimeError where Blender cannot compute them (n-gons)."""

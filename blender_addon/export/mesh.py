@@ -117,12 +117,18 @@ def read_mesh(mesh, check_cancel=None, phases=None):
                 data.foreach_get("color", col)
             except (TypeError, RuntimeError, AttributeError):
                 continue
-            col = col.reshape(-1, 4)
+            raw.colors.append((name, col.reshape(-1, 4), domain))
+        # Named float and vector attributes travel as colour layers too: the Attribute node
+        # reads both by name.
+        skip = {name for name, _, _ in raw.colors} | {name for name, _ in raw.uvs}
+        sizes = {"CORNER": n_loops, "POINT": n_verts, "FACE": n_polys}
+        for name, domain, values in compat.generic_attributes(mesh, sizes, skip):
+            raw.colors.append((name, values, domain))
+        for i, (name, col, domain) in enumerate(raw.colors):
             if domain == "FACE":
-                # Each corner takes its face's colour (faces' corners are consecutive).
+                # Each corner takes its face's value (faces' corners are consecutive).
                 sizes = np.diff(np.append(raw.loop_start, n_loops))
-                col, domain = np.repeat(col, sizes, axis=0), "CORNER"
-            raw.colors.append((name, col, domain))
+                raw.colors[i] = (name, np.repeat(col, sizes, axis=0), "CORNER")
     checkpoint()
     raw.texspace = compat.texture_space(mesh)
     return raw

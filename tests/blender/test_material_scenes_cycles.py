@@ -368,6 +368,60 @@ def oren_nayar_ball(kind):
     return build
 
 
+def black_base_ball():
+    """A Principled BSDF of base colour exactly black (roughness 0.5) in a bright world: all
+    its light is the specular layer's, and the diffuse base below samples directions too."""
+    mat, nt, out = node_material("BlackBase")
+    principled(nt, out, Base_Color=(0.0, 0.0, 0.0, 1.0), Roughness=0.5)
+    _sphere_stage(mat, world_strength=1.0)
+
+
+def named_attribute(data_type, domain, output):
+    """Geometry Nodes store 0.33 P + 0.5 (a FLOAT from its x) as the attribute 'myattr' on a
+    grid's points or faces; the material's Attribute node reads it into the base colour."""
+    def build():
+        import bmesh
+        mat, nt, out = node_material("NamedAttr")
+        a = node(nt, "ShaderNodeAttribute", {"attribute_name": "myattr",
+                                             "attribute_type": "GEOMETRY"})
+        principled(nt, out, Base_Color=a.outputs[output], Roughness=0.8)
+        me = bpy.data.meshes.new("Grid")
+        bm = bmesh.new()
+        bmesh.ops.create_grid(bm, x_segments=20, y_segments=20, size=1.5)
+        bm.to_mesh(me)
+        bm.free()
+        me.materials.append(mat)
+        ob = bpy.data.objects.new("Grid", me)
+        bpy.context.scene.collection.objects.link(ob)
+        tree = bpy.data.node_groups.new("StoreAttr", "GeometryNodeTree")
+        tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+        tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+        gi, go = tree.nodes.new("NodeGroupInput"), tree.nodes.new("NodeGroupOutput")
+        ob.modifiers.new("StoreAttr", "NODES").node_group = tree
+        pos = tree.nodes.new("GeometryNodeInputPosition")
+        madd = tree.nodes.new("ShaderNodeVectorMath")
+        madd.operation = "MULTIPLY_ADD"
+        madd.inputs[1].default_value = (0.33, 0.33, 0.33)
+        madd.inputs[2].default_value = (0.5, 0.5, 0.5)
+        tree.links.new(pos.outputs[0], madd.inputs[0])
+        store = tree.nodes.new("GeometryNodeStoreNamedAttribute")
+        store.data_type, store.domain = data_type, domain
+        store.inputs["Name"].default_value = "myattr"
+        tree.links.new(gi.outputs[0], store.inputs["Geometry"])
+        value = next(i for i in store.inputs if i.enabled and i.name == "Value")
+        if data_type == "FLOAT":
+            sep = tree.nodes.new("ShaderNodeSeparateXYZ")
+            tree.links.new(madd.outputs[0], sep.inputs[0])
+            tree.links.new(sep.outputs[0], value)
+        else:
+            tree.links.new(madd.outputs[0], value)
+        tree.links.new(store.outputs[0], go.inputs[0])
+        scenes.add_sun_light("Sun", (-0.6, 0.4, -0.7), 3.0)
+        world(0.2)
+        scenes.add_camera((0.0, -3.5, 2.8), (0.0, 0.0, 0.0), fov=math.radians(45.0))
+    return build
+
+
 def coloured_multiscatter(kind):
     """A rough Multiscatter GGX ball of colour 0.5 (Glossy at roughness 1, Glass at 0.8) in a
     bright uniform world: the energy compensation darkens it by the colour's multiple bounces
@@ -788,6 +842,11 @@ CASES = [
                  marks=pytest.mark.xfail(reason=LOWPOLY_REASON, strict=False)),
     ("oren_nayar_diffuse_ball", oren_nayar_ball("diffuse"), 2, 128, 512),
     ("oren_nayar_principled_ball", oren_nayar_ball("principled"), 2, 128, 512),
+    ("principled_black_base", black_base_ball, 2, 128, 512),
+    ("named_float_attribute_points", named_attribute("FLOAT", "POINT", "Fac"), 0, 64, 256),
+    ("named_float_attribute_faces", named_attribute("FLOAT", "FACE", "Color"), 0, 64, 256),
+    ("named_vector_attribute_points", named_attribute("FLOAT_VECTOR", "POINT", "Vector"),
+     0, 64, 256),
     ("multiscatter_glossy_coloured", coloured_multiscatter("glossy"), 2, 128, 512),
     ("multiscatter_glass_coloured", coloured_multiscatter("glass"), 6, 128, 512),
     ("add_diffuse_glossy_fresnel", add_fresnel, 0, 256, 1024),
