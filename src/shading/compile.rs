@@ -201,7 +201,8 @@ impl<'g> Compiler<'g> {
         if method != "BUMP" {
             let n = &self.graph.nodes[node];
             self.warn(format!(
-                "material '{}': displacement method {method} from node '{}' ({}): the                  vertices are not displaced, the displacement is rendered as bump only",
+                "material '{}': displacement method {method} from node '{}' ({}): the vertices are \
+                 not displaced, the displacement is rendered as bump only",
                 self.material, n.name, n.kind
             ));
         }
