@@ -164,7 +164,7 @@ fn grad4(hash: u32, x: f32, y: f32, z: f32, w: f32) -> f32 {
 // Perlin noise, unscaled and unwrapped (textures use `snoise_*`). Zero at lattice points.
 
 /// 1D Perlin noise: `lerp(g₀·fx, g₁·(fx − 1), fade(fx))`, slopes `g ∈ ±{1..8}`.
-#[inline]
+#[inline(always)]
 pub fn perlin_1d(x: f32) -> f32 {
     let (fx, xi) = floorfrac(x);
     let u = fade(fx);
@@ -176,7 +176,7 @@ pub fn perlin_1d(x: f32) -> f32 {
 }
 
 /// 2D Perlin noise; blended along x, then y.
-#[inline]
+#[inline(always)]
 pub fn perlin_2d(x: f32, y: f32) -> f32 {
     let (fx, xi) = floorfrac(x);
     let (fy, yi) = floorfrac(y);
@@ -191,7 +191,7 @@ pub fn perlin_2d(x: f32, y: f32) -> f32 {
 }
 
 /// 3D Perlin noise; blended along x, then y, then z.
-#[inline]
+#[inline(always)]
 pub fn perlin_3d(x: f32, y: f32, z: f32) -> f32 {
     let (fx, xi) = floorfrac(x);
     let (fy, yi) = floorfrac(y);
@@ -213,7 +213,7 @@ pub fn perlin_3d(x: f32, y: f32, z: f32) -> f32 {
 }
 
 /// 4D Perlin noise; blended along w first, then x, y, z (the order of Cycles' AVX2 kernel).
-#[inline]
+#[inline(always)]
 pub fn perlin_4d(x: f32, y: f32, z: f32, w: f32) -> f32 {
     let (fx, xi) = floorfrac(x);
     let (fy, yi) = floorfrac(y);
@@ -249,25 +249,25 @@ const SCALE_3D: f32 = 0.9820;
 const SCALE_4D: f32 = 0.8344;
 
 /// Signed 1D noise: `0.25 · perlin_1d(wrap(p))`, about `[-1, 1]`.
-#[inline]
+#[inline(always)]
 pub fn snoise_1d(p: f32) -> f32 {
     SCALE_1D * perlin_1d(wrap_exact(p))
 }
 
 /// Signed 2D noise: `0.6616 · perlin_2d(wrap(p))`.
-#[inline]
+#[inline(always)]
 pub fn snoise_2d(p: Vec2) -> f32 {
     SCALE_2D * perlin_2d(wrap_exact(p.x), wrap_exact(p.y))
 }
 
 /// Signed 3D noise: `0.982 · perlin_3d(wrap(p))`.
-#[inline]
+#[inline(always)]
 pub fn snoise_3d(p: Vec3) -> f32 {
     SCALE_3D * perlin_3d(wrap_simd(p.x), wrap_simd(p.y), wrap_simd(p.z))
 }
 
 /// Signed 4D noise: `0.8344 · perlin_4d(wrap(p))`.
-#[inline]
+#[inline(always)]
 pub fn snoise_4d(p: Vec4) -> f32 {
     SCALE_4D
         * perlin_4d(
@@ -279,25 +279,25 @@ pub fn snoise_4d(p: Vec4) -> f32 {
 }
 
 /// Unsigned 1D noise `0.5 · snoise + 0.5`, about `[0, 1]`.
-#[inline]
+#[inline(always)]
 pub fn noise_1d(p: f32) -> f32 {
     0.5 * snoise_1d(p) + 0.5
 }
 
 /// Unsigned 2D noise `0.5 · snoise + 0.5`.
-#[inline]
+#[inline(always)]
 pub fn noise_2d(p: Vec2) -> f32 {
     0.5 * snoise_2d(p) + 0.5
 }
 
 /// Unsigned 3D noise `0.5 · snoise + 0.5`.
-#[inline]
+#[inline(always)]
 pub fn noise_3d(p: Vec3) -> f32 {
     0.5 * snoise_3d(p) + 0.5
 }
 
 /// Unsigned 4D noise `0.5 · snoise + 0.5`.
-#[inline]
+#[inline(always)]
 pub fn noise_4d(p: Vec4) -> f32 {
     0.5 * snoise_4d(p) + 0.5
 }
@@ -313,33 +313,33 @@ pub trait NoisePoint: Copy + Add<Output = Self> + Mul<f32, Output = Self> {
 }
 
 impl NoisePoint for f32 {
-    #[inline]
+    #[inline(always)]
     fn snoise(self) -> f32 {
         snoise_1d(self)
     }
-    #[inline]
+    #[inline(always)]
     fn snoise_plus(self, c: f32) -> f32 {
         SCALE_1D.mul_add(perlin_1d(wrap_exact(self)), c)
     }
 }
 
 impl NoisePoint for Vec2 {
-    #[inline]
+    #[inline(always)]
     fn snoise(self) -> f32 {
         snoise_2d(self)
     }
-    #[inline]
+    #[inline(always)]
     fn snoise_plus(self, c: f32) -> f32 {
         SCALE_2D.mul_add(perlin_2d(wrap_exact(self.x), wrap_exact(self.y)), c)
     }
 }
 
 impl NoisePoint for Vec3 {
-    #[inline]
+    #[inline(always)]
     fn snoise(self) -> f32 {
         snoise_3d(self)
     }
-    #[inline]
+    #[inline(always)]
     fn snoise_plus(self, c: f32) -> f32 {
         let n = perlin_3d(wrap_simd(self.x), wrap_simd(self.y), wrap_simd(self.z));
         SCALE_3D.mul_add(n, c)
@@ -347,11 +347,11 @@ impl NoisePoint for Vec3 {
 }
 
 impl NoisePoint for Vec4 {
-    #[inline]
+    #[inline(always)]
     fn snoise(self) -> f32 {
         snoise_4d(self)
     }
-    #[inline]
+    #[inline(always)]
     fn snoise_plus(self, c: f32) -> f32 {
         let n = perlin_4d(
             wrap_simd(self.x),
@@ -378,7 +378,7 @@ fn octaves(detail: f32) -> i32 {
 /// Fractal Brownian motion: `sum = Σ r^i · snoise(L^i · p)`, plus the fractional octave
 /// (`lerp(sum, sum + r^n·snoise(L^n·p), fract(detail))`). With `normalize`, each sum is mapped
 /// by `0.5 · sum / Σ r^i + 0.5` (about `[0, 1]`) before that lerp.
-#[inline]
+#[inline(always)]
 pub fn fbm<P: NoisePoint>(
     p: P,
     detail: f32,
@@ -419,7 +419,7 @@ pub fn fbm<P: NoisePoint>(
 
 /// Multifractal: `Π (r^i · snoise(L^i · p) + 1)`; the fractional octave multiplies by
 /// `(fract(detail) · r^n · snoise + 1)`.
-#[inline]
+#[inline(always)]
 pub fn multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacunarity: f32) -> f32 {
     let mut value = 1.0f32;
     let mut pwr = 1.0f32;
@@ -437,7 +437,7 @@ pub fn multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacun
 
 /// Heterogeneous terrain: `v = offset + snoise(p)`, then for i ≥ 1
 /// `v += (snoise(L^i p) + offset) · r^i · v` (the fractional octave scaled by `fract(detail)`).
-#[inline]
+#[inline(always)]
 pub fn hetero_terrain<P: NoisePoint>(
     mut p: P,
     detail: f32,
@@ -465,7 +465,7 @@ pub fn hetero_terrain<P: NoisePoint>(
 /// Hybrid additive/multiplicative multifractal: `signal = (snoise(L^i p) + offset) · r^i`,
 /// `value += w · signal`, `w ← min(w, 1) · gain · signal` (w starts at 1), stopping once
 /// `w ≤ 0.001`; the fractional octave adds `fract(detail) · w · signal`.
-#[inline]
+#[inline(always)]
 pub fn hybrid_multi_fractal<P: NoisePoint>(
     mut p: P,
     detail: f32,
@@ -500,7 +500,7 @@ pub fn hybrid_multi_fractal<P: NoisePoint>(
 /// Ridged multifractal: `signal_i = (offset − |snoise(L^i p)|)² · saturate(signal_{i−1} · gain)`
 /// (no weight for i = 0), `value = Σ r^i · signal_i`. Only whole octaves count: Cycles ignores
 /// the fraction of `detail` here.
-#[inline]
+#[inline(always)]
 pub fn ridged_multi_fractal<P: NoisePoint>(
     mut p: P,
     detail: f32,
@@ -592,7 +592,7 @@ struct Fractal {
 }
 
 impl Fractal {
-    #[inline]
+    #[inline(always)]
     fn eval<P: NoisePoint>(&self, p: P) -> f32 {
         let (d, r, l) = (self.detail, self.roughness, self.lacunarity);
         match self.kind {
@@ -610,7 +610,7 @@ impl Fractal {
 
     /// `(value, color)` at an already distorted point; the colour's second and third channels
     /// are the fractal at `p + off_g` and `p + off_b`.
-    #[inline]
+    #[inline(always)]
     fn value_color<P: NoisePoint>(
         &self,
         p: P,
@@ -696,6 +696,29 @@ const OFFSETS_4D: [Vec4; 6] = [
 /// (non-finite inputs or overflowing parameters) its film writes 0 (`ensure_finite`), and so
 /// do we.
 pub fn noise_texture(p: Vec3, w: f32, params: &NoiseParams, want_color: bool) -> (f32, Vec3) {
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("fma") {
+        // SAFETY: the CPU has FMA, checked just above.
+        return unsafe { noise_texture_fma(p, w, params, want_color) };
+    }
+    noise_texture_impl(p, w, params, want_color)
+}
+
+/// [`noise_texture`] compiled with FMA: its `mul_add`s (Cycles' fused operations) become
+/// single instructions instead of calls; the results are the same, an FMA being exact.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma")]
+unsafe fn noise_texture_fma(
+    p: Vec3,
+    w: f32,
+    params: &NoiseParams,
+    want_color: bool,
+) -> (f32, Vec3) {
+    noise_texture_impl(p, w, params, want_color)
+}
+
+#[inline(always)]
+fn noise_texture_impl(p: Vec3, w: f32, params: &NoiseParams, want_color: bool) -> (f32, Vec3) {
     let f = Fractal {
         kind: params.kind,
         normalize: params.normalize,
