@@ -169,6 +169,38 @@ def test_face_colours_reach_every_corner_of_their_face(clean):
     assert len(data.color_sets) == 2
 
 
+def test_named_attributes_travel_as_colour_layers(clean):
+    """Float, boolean and vector attributes (Geometry Nodes' Store Named Attribute) reach
+    every corner as colour layers in Cycles' conversions: (f, f, f, 1), (x, y, z, 1); UV maps
+    and Blender's own attributes stay out."""
+    me = _grid("Attrs")
+    n, nf = len(me.vertices), len(me.polygons)
+    height = np.linspace(0.0, 1.0, n, dtype=np.float32)
+    me.attributes.new("height", "FLOAT", "POINT").data.foreach_set("value", height)
+    mask = np.arange(n) % 3 == 0
+    me.attributes.new("mask", "BOOLEAN", "POINT").data.foreach_set("value", mask)
+    flow = np.random.default_rng(9).random((nf, 3)).astype(np.float32)
+    me.attributes.new("flow", "FLOAT_VECTOR", "FACE").data.foreach_set("vector", flow.ravel())
+    data = export_mesh.mesh_arrays(me)
+    layers = dict(data.color_sets)
+    assert set(layers) == {"height", "mask", "flow"}
+    # glTF vertex -> Blender vertex by position (the grid's are distinct).
+    co = np.empty(n * 3, dtype=np.float32)
+    me.vertices.foreach_get("co", co)
+    key = {tuple(p): i for i, p in enumerate(co.reshape(-1, 3).round(5))}
+    vert = np.array([key[tuple(p)] for p in data.positions.round(5)])
+    for name, want in (("height", height), ("mask", mask.astype(np.float32))):
+        got = layers[name]
+        assert np.array_equal(got[:, :3], np.repeat(want[vert][:, None], 3, axis=1)), name
+        assert np.all(got[:, 3] == 1.0), name
+    # Each triangle's corners carry its face's vector.
+    me.calc_loop_triangles()
+    tri_face = np.empty(len(me.loop_triangles), dtype=np.int32)
+    me.loop_triangles.foreach_get("polygon_index", tri_face)
+    got = layers["flow"][data.indices.astype(np.int64)]
+    assert np.array_equal(got[..., :3], np.repeat(flow[tri_face][:, None, :], 3, axis=1))
+
+
 def test_flat_shading(clean):
     me = _sphere("Facets", smooth=False)
     assert compat.normals(me, len(me.loops))[0] == "FACE"
