@@ -116,8 +116,8 @@ pub fn filter(
 }
 
 /// The texel `(x0, y0)` at or before glTF `uv` and the fractions `(fx, fy)` towards the next
-/// ones: the corners and weights of bilinear filtering (texel centres at half-integers;
-/// clamped to a range where the i64 conversion is exact).
+/// ones (texel centres at half-integers; clamped to a range where the i64 conversion is
+/// exact): where bilinear and cubic filtering take their texels and weights.
 #[inline(always)]
 fn bilinear_at(width: u32, height: u32, uv: Vec2) -> (i64, i64, f32, f32) {
     let x = (uv.x as f64 * width as f64 - 0.5).clamp(-1e9, 1e9);
@@ -130,11 +130,7 @@ fn bilinear_at(width: u32, height: u32, uv: Vec2) -> (i64, i64, f32, f32) {
 /// (glTF convention, as [`filter`]), texel centres at half-integers; `fetch` wraps or clips.
 /// Its weights are positive, so the result stays within the texels' range.
 pub fn filter_cubic(width: u32, height: u32, uv: Vec2, fetch: impl Fn(i64, i64) -> Vec4) -> Vec4 {
-    let x = (uv.x as f64 * width as f64 - 0.5).clamp(-1e9, 1e9);
-    let y = (uv.y as f64 * height as f64 - 0.5).clamp(-1e9, 1e9);
-    let (x0, y0) = (x.floor(), y.floor());
-    let (tx, ty) = ((x - x0) as f32, (y - y0) as f32);
-    let (x0, y0) = (x0 as i64, y0 as i64);
+    let (x0, y0, tx, ty) = bilinear_at(width, height, uv);
     let (u, v) = (bspline_weights(tx), bspline_weights(ty));
     let mut sum = Vec4::ZERO;
     for (j, wy) in v.iter().enumerate() {
