@@ -110,9 +110,9 @@ def read_mesh(mesh, check_cancel=None, phases=None):
             raw.uvs.append((layer.name, compat.corner_uv(layer, n_loops)))
     checkpoint()
     with phases("colors"):
+        counts = {"CORNER": n_loops, "POINT": n_verts, "FACE": n_polys}
         for name, domain, data in compat.color_layers(mesh):
-            n = {"CORNER": n_loops, "POINT": n_verts, "FACE": n_polys}[domain]
-            col = np.empty(n * 4, dtype=np.float32)
+            col = np.empty(counts[domain] * 4, dtype=np.float32)
             try:
                 data.foreach_get("color", col)
             except (TypeError, RuntimeError, AttributeError):
@@ -121,14 +121,14 @@ def read_mesh(mesh, check_cancel=None, phases=None):
         # Named float and vector attributes travel as colour layers too: the Attribute node
         # reads both by name.
         skip = {name for name, _, _ in raw.colors} | {name for name, _ in raw.uvs}
-        sizes = {"CORNER": n_loops, "POINT": n_verts, "FACE": n_polys}
-        for name, domain, values in compat.generic_attributes(mesh, sizes, skip):
-            raw.colors.append((name, values, domain))
-        for i, (name, col, domain) in enumerate(raw.colors):
-            if domain == "FACE":
-                # Each corner takes its face's value (faces' corners are consecutive).
-                sizes = np.diff(np.append(raw.loop_start, n_loops))
-                raw.colors[i] = (name, np.repeat(col, sizes, axis=0), "CORNER")
+        raw.colors += [(name, values, domain) for name, domain, values
+                       in compat.generic_attributes(mesh, counts, skip)]
+        if any(domain == "FACE" for _, _, domain in raw.colors):
+            # Each corner takes its face's value (faces' corners are consecutive).
+            face_corners = np.diff(np.append(raw.loop_start, n_loops))
+            raw.colors = [(name, np.repeat(col, face_corners, axis=0), "CORNER")
+                          if domain == "FACE" else (name, col, domain)
+                          for name, col, domain in raw.colors]
     checkpoint()
     raw.texspace = compat.texture_space(mesh)
     return raw
@@ -450,15 +450,16 @@ def object_extras(inst, obj, view_layer=None):
            "pass_index": int(getattr(obj, "pass_index", 0)),
            "color": [float(v) for v in getattr(obj, "color", (1.0, 1.0, 1.0, 1.0))],
            "location": [float(m[0][3]), float(m[1][3]), float(m[2][3])]}
-    # An instance is hidden from the rays its object or its instancer is hidden from.
+    # An instance is hidden from the rays its object or its instancer is hidden from, and is
+    # a holdout where either is.
+    instancer = inst.parent if inst.is_instance else None
     vis = compat.ray_visibility(obj)
-    if inst.is_instance and inst.parent is not None:
-        parent = compat.ray_visibility(inst.parent)
+    if instancer is not None:
+        parent = compat.ray_visibility(instancer)
         vis = {k: v and parent[k] for k, v in vis.items()}
     if not all(vis.values()):
         out["visibility"] = vis
-    parent = inst.parent if inst.is_instance else None
     if compat.is_holdout(obj, view_layer) or (
-            parent is not None and compat.is_holdout(parent, view_layer)):
+            instancer is not None and compat.is_holdout(instancer, view_layer)):
         out["holdout"] = True
     return out
