@@ -194,7 +194,8 @@ pub fn sample_henyey_greenstein(g: f32, d: Vec3, u: Vec2) -> (Vec3, f32) {
     let sin = (1.0 - cos * cos).max(0.0).sqrt();
     let phi = 2.0 * PI * u.y;
     let frame = crate::frame::Frame::from_normal(d);
-    let wo = frame.to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos));
+    let (sin_phi, cos_phi) = crate::trig::sin_cos(phi);
+    let wo = frame.to_world(Vec3::new(sin * cos_phi, sin * sin_phi, cos));
     (wo, henyey_greenstein(g, cos))
 }
 

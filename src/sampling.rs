@@ -19,7 +19,8 @@ pub fn square_to_uniform_disk(u: Vec2) -> Vec2 {
     } else {
         (a.y, PI / 2.0 - PI / 4.0 * (a.x / a.y))
     };
-    Vec2::new(r * phi.cos(), r * phi.sin())
+    let (s, c) = crate::trig::sin_cos(phi);
+    Vec2::new(r * c, r * s)
 }
 
 /// Cosine-weighted direction on the +Z hemisphere. Density `cos θ / π` per steradian.
@@ -42,7 +43,8 @@ pub fn square_to_uniform_sphere(u: Vec2) -> Vec3 {
     let z = 1.0 - 2.0 * u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
     let phi = 2.0 * PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (s, c) = crate::trig::sin_cos(phi);
+    Vec3::new(r * c, r * s, z)
 }
 
 /// Density of [`square_to_uniform_sphere`].
@@ -58,7 +60,8 @@ pub fn square_to_uniform_cone(u: Vec2, cos_max: f32) -> Vec3 {
     let z = 1.0 - u.x * (1.0 - cos_max);
     let r = (1.0 - z * z).max(0.0).sqrt();
     let phi = 2.0 * PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (s, c) = crate::trig::sin_cos(phi);
+    Vec3::new(r * c, r * s, z)
 }
 
 /// Density of [`square_to_uniform_cone`] for a direction inside the cone.

@@ -61,8 +61,9 @@ pub fn sample_visible_normal(wi: Vec3, alpha: f32, u: Vec2) -> Vec3 {
     let t2 = vh.cross(t1);
     let r = u.x.sqrt();
     let phi = 2.0 * PI * u.y;
-    let p1 = r * phi.cos();
-    let mut p2 = r * phi.sin();
+    let (sin_phi, cos_phi) = crate::trig::sin_cos(phi);
+    let p1 = r * cos_phi;
+    let mut p2 = r * sin_phi;
     let s = 0.5 * (1.0 + vh.z);
     p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * p2;
     let nh = t1 * p1 + t2 * p2 + vh * (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
@@ -140,8 +141,9 @@ pub fn sample_visible_normal_aniso(wi: Vec3, alpha_x: f32, alpha_y: f32, u: Vec2
     let t2 = vh.cross(t1);
     let r = u.x.sqrt();
     let phi = 2.0 * PI * u.y;
-    let p1 = r * phi.cos();
-    let mut p2 = r * phi.sin();
+    let (sin_phi, cos_phi) = crate::trig::sin_cos(phi);
+    let p1 = r * cos_phi;
+    let mut p2 = r * sin_phi;
     let s = 0.5 * (1.0 + vh.z);
     p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * p2;
     let nh = t1 * p1 + t2 * p2 + vh * (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();

@@ -100,7 +100,7 @@ impl SphericalRect {
         // plane through the point that cuts the rectangle at x = xu.
         let (b0, b1) = (self.nz[0], self.nz[2]);
         let au = u.x * self.solid_angle + self.g[2] + self.g[3];
-        let (s, c) = au.sin_cos();
+        let (s, c) = crate::trig::sin_cos(au);
         let fu = if s != 0.0 {
             (c * b0 + b1) / s
         } else {

@@ -101,7 +101,7 @@ fn cone_union(wa: Vec3, ta: f32, wb: Vec3, tb: f32) -> (Vec3, f32) {
         return (wa, PI);
     };
     // Rotate wa towards wb by t - ta (Rodrigues; k ⟂ wa).
-    let (s, co) = (t - ta).sin_cos();
+    let (s, co) = crate::trig::sin_cos(t - ta);
     let w = (wa * co + k.cross(wa) * s).normalize();
     (w, t)
 }

@@ -50,7 +50,8 @@ pub fn sample_cone(axis: Vec3, omc: f32, u: Vec2) -> Vec3 {
     let cos = 1.0 - t;
     let sin = (t * (2.0 - t)).max(0.0).sqrt();
     let phi = 2.0 * PI * u.y;
-    Frame::from_normal(axis).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos))
+    let (sin_phi, cos_phi) = crate::trig::sin_cos(phi);
+    Frame::from_normal(axis).to_world(Vec3::new(sin * cos_phi, sin * sin_phi, cos))
 }
 
 /// Whether the unit `w` lies in the cone around the unit `axis` with `1 - cos` = `omc`.

@@ -297,7 +297,8 @@ fn sample_phase(d: Vec3, g: f32, u: Vec2) -> Vec3 {
     let cos = ((1.0 + g * g - k * k) / (2.0 * g)).clamp(-1.0, 1.0);
     let sin = (1.0 - cos * cos).max(0.0).sqrt();
     let phi = std::f32::consts::TAU * u.y;
-    Frame::from_normal(d).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos))
+    let (sin_phi, cos_phi) = crate::trig::sin_cos(phi);
+    Frame::from_normal(d).to_world(Vec3::new(sin * cos_phi, sin * sin_phi, cos))
 }
 
 /// Walks from `p` along the unit `d` through `m`, starting with throughput `throughput` (the
