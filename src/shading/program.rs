@@ -81,7 +81,7 @@ impl Op {
             Op::Utility(op) => op.eval(s),
             Op::Bump(op) => op.eval(s, g),
             Op::Displacement(op) => op.eval(s, g),
-            Op::Environment(op) => op.eval(s, env),
+            Op::Environment(op) => op.eval(s, g, env),
             Op::Sky(op) => op.eval(s, g),
         }
     }

@@ -16,15 +16,17 @@ use std::f32::consts::PI;
 
 /// Blender-world direction → Cycles' equirectangular `(u, v)` (`v = 0` at the bottom of the
 /// image, `-Z`; `u = 0.5` towards `+X`, `u` growing towards `-Y`): Cycles'
-/// `direction_to_equirectangular`. A zero direction gives `(0, 0)`.
+/// `direction_to_equirectangular`. `d` need not be unit: both angles are ratios of its
+/// components. A zero direction (or one whose squared length overflows) gives `(0, 0)`.
 #[inline(always)]
 pub fn direction_to_equirectangular(d: Vec3) -> Vec2 {
-    let len = d.length();
-    if len == 0.0 || !len.is_finite() {
+    let rho2 = d.x * d.x + d.y * d.y;
+    let len2 = rho2 + d.z * d.z;
+    if len2 == 0.0 || !len2.is_finite() {
         return Vec2::ZERO;
     }
     // acos(z / |d|) as atan2(ρ, z): one inlined arctangent form for both angles.
-    let rho = (d.x * d.x + d.y * d.y).sqrt();
+    let rho = rho2.sqrt();
     let u = (crate::trig::atan2(d.y, d.x) - PI) / (-2.0 * PI);
     let v = (crate::trig::atan2(rho, d.z) - PI) / -PI;
     Vec2::new(u, v)
@@ -35,6 +37,8 @@ pub fn direction_to_equirectangular(d: Vec3) -> Vec2 {
 pub fn equirectangular_to_direction(u: f32, v: f32) -> Vec3 {
     let phi = -2.0 * PI * u + PI;
     let theta = -PI * v + PI;
+    // libm's, not `trig::sin_cos`: at its sub-ulp accuracy a map sample's direction maps
+    // back into the sample's own cell, so its density is `pdf_dir` of the direction.
     let (st, ct) = theta.sin_cos();
     let (sp, cp) = phi.sin_cos();
     Vec3::new(st * cp, st * sp, ct)
@@ -68,30 +72,32 @@ pub struct EnvironmentOp {
     sampler: Texture,
     srgb: bool,
     mirror_ball: bool,
-    vector: Slot,
+    /// The direction; `None`: the shading point's position (the view direction), read
+    /// straight from the globals rather than through a slot.
+    vector: Option<Slot>,
     color: Slot,
     alpha: Slot,
 }
 
 impl EnvironmentOp {
     #[inline]
-    pub fn eval(&self, s: &mut Slots, env: &ShadeEnv) {
-        let v = s.v(self.vector);
+    pub fn eval(&self, s: &mut Slots, g: &ShaderGlobals, env: &ShadeEnv) {
+        let v = self.vector.map_or(g.p, |v| s.v(v));
         let Some(img) = env.images.get(self.image) else {
             s.set_v(self.color, Vec3::new(1.0, 0.0, 1.0));
             s.set_f(self.alpha, 1.0);
             return;
         };
-        let len = v.length();
-        let d = if len > 0.0 && len.is_finite() {
-            v / len
-        } else {
-            Vec3::ZERO
-        };
         let uv = if self.mirror_ball {
-            direction_to_mirrorball(d)
+            let len = v.length();
+            direction_to_mirrorball(if len > 0.0 && len.is_finite() {
+                v / len
+            } else {
+                Vec3::ZERO
+            })
         } else {
-            direction_to_equirectangular(d)
+            // Scale-free: no normalisation needed.
+            direction_to_equirectangular(v)
         };
         // Cycles' v runs up the image; the renderer's images run top to bottom.
         let c = texture::lookup(&self.sampler, img, Vec2::new(uv.x, 1.0 - uv.y), self.srgb);
@@ -122,7 +128,11 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
     if kind != "ShaderNodeTexEnvironment" {
         return Ok(false);
     }
-    let vector = direction_input(cx)?;
+    let vector = if cx.is_linked("Vector") {
+        Some(cx.vector("Vector", Vec3::ZERO)?)
+    } else {
+        None
+    };
     let color = cx.output("Color", SocketType::Color)?;
     let alpha = cx.output("Alpha", SocketType::Float)?;
     let Some(image) = cx.node().image else {
