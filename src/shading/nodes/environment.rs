@@ -37,10 +37,8 @@ pub fn direction_to_equirectangular(d: Vec3) -> Vec2 {
 pub fn equirectangular_to_direction(u: f32, v: f32) -> Vec3 {
     let phi = -2.0 * PI * u + PI;
     let theta = -PI * v + PI;
-    // libm's, not `trig::sin_cos`: at its sub-ulp accuracy a map sample's direction maps
-    // back into the sample's own cell, so its density is `pdf_dir` of the direction.
-    let (st, ct) = theta.sin_cos();
-    let (sp, cp) = phi.sin_cos();
+    let (st, ct) = crate::trig::sin_cos(theta);
+    let (sp, cp) = crate::trig::sin_cos(phi);
     Vec3::new(st * cp, st * sp, ct)
 }
 
