@@ -73,8 +73,8 @@ const SIN_COS_LIMIT: f32 = 1.0e5;
 
 /// `(sin x, cos x)` rounded from double precision (as libm's, within an ulp of the exact
 /// values, and the same on every machine) for `|x| ≤ 1e5`: the argument is reduced to
-/// `|r| ≤ π/4` (Cody and Waite's two-part π/2) and both Taylor series are summed to within 1e-11. Beyond, and for NaN,
-/// libm's.
+/// `|r| ≤ π/4` (Cody and Waite's two-part π/2) and both Taylor series are summed to within
+/// 1e-11. Beyond, and for NaN, libm's.
 #[inline]
 pub fn sin_cos(x: f32) -> (f32, f32) {
     if x.is_nan() || x.abs() > SIN_COS_LIMIT {
