@@ -28,7 +28,7 @@ use crate::shading::globals::ray;
 use crate::shading::globals::{ShadeEnv, from_blender, to_blender};
 use crate::shading::graph::Graph;
 use crate::shading::nodes::environment::{
-    background_globals, direction_to_equirectangular, equirectangular_to_direction,
+    ImageWorld, background_globals, direction_to_equirectangular, equirectangular_to_direction,
 };
 use crate::shading::nodes::sky::{self, GuidedSun, Suns};
 use glam::{Mat4, Vec2, Vec3};
@@ -244,6 +244,9 @@ impl Distribution2D {
 #[derive(Clone, Debug)]
 pub struct Environment {
     program: Arc<Program>,
+    /// The program, when it is only an image times a constant, in the form that evaluates
+    /// it directly (to the same values).
+    image_world: Option<ImageWorld>,
     /// The camera in Blender's coordinates (Texture Coordinate's Camera output).
     camera_to_world: Mat4,
     /// The importance map; `None`: uniform over the sphere (a world whose luminance does not
@@ -310,6 +313,7 @@ impl Environment {
         res: Option<[usize; 3]>,
     ) -> Environment {
         let mut env = Environment {
+            image_world: program.image_world(),
             program,
             camera_to_world,
             dist: None,
@@ -415,6 +419,9 @@ impl Environment {
     /// `d` (renderer world) leaving path vertex `depth - 1` with Light Path bits `flags`.
     #[inline]
     pub fn radiance(&self, scene: &Scene, d: Vec3, depth: u32, flags: u32) -> Vec3 {
+        if let Some(w) = &self.image_world {
+            return w.emission(to_blender(d), &scene.images);
+        }
         let g = background_globals(d, depth, flags);
         self.program.emission(&g, &self.shade_env(scene))
     }
@@ -746,6 +753,84 @@ mod tests {
         // The light's power counts the sun, and the sky besides.
         assert_eq!(env.sun_irradiance, luminance(sun.power));
         assert!(env.power(&scene, 1.0) > luminance(sun.power) * PI);
+    }
+
+    /// The image world's direct evaluation gives the program's emission to the bit, for
+    /// filtered, closest, sRGB and mirror-ball lookups, odd texels (negative, huge, NaN) and
+    /// strengths; a world with anything more is left to the program.
+    #[test]
+    fn an_image_world_evaluates_as_its_program() {
+        let (w, h) = (7u32, 5u32);
+        let mut float = Vec::new();
+        for k in 0..w * h {
+            let x = k as f32;
+            float.push(match k % 9 {
+                0 => [-0.5, 2.0, 0.25, 1.0],
+                4 => [f32::NAN, 1.0, 3e38, 0.5],
+                _ => [x * 0.37 % 1.3, x * 0.11 % 0.9, 40.0 / (1.0 + x), 1.0],
+            });
+        }
+        let image = Image {
+            width: w,
+            height: h,
+            rgba8: Vec::new(),
+            float,
+        };
+        let world = |interp: &str, colorspace: &str, projection: &str, strength: f32| {
+            let mut g = Graph::default();
+            let mut n = crate::shading::Node::new("ShaderNodeTexEnvironment")
+                .prop("interpolation", serde_json::json!(interp))
+                .prop("colorspace", serde_json::json!(colorspace))
+                .prop("projection", serde_json::json!(projection));
+            n.image = Some(0);
+            let env = g.add(n);
+            let bg = g.add(
+                crate::shading::Node::new("ShaderNodeBackground")
+                    .link("Color", env, "Color")
+                    .with("Strength", &[strength]),
+            );
+            g.surface = Some((bg, "Background".into()));
+            g
+        };
+        let mut checked = 0;
+        for (interp, cs, proj, strength) in [
+            ("Linear", "Non-Color", "EQUIRECTANGULAR", 1.0),
+            ("Closest", "Non-Color", "EQUIRECTANGULAR", 2.5),
+            ("Linear", "sRGB", "EQUIRECTANGULAR", 0.7),
+            ("Linear", "Non-Color", "MIRROR_BALL", 1.3),
+            ("Linear", "Non-Color", "EQUIRECTANGULAR", 0.0),
+            ("Linear", "Non-Color", "EQUIRECTANGULAR", -1.0),
+        ] {
+            let mut scene = Scene::default();
+            scene.images.push(image.clone());
+            scene.world.graph = Some(world(interp, cs, proj, strength));
+            let program = crate::shading::compile(scene.world.graph.as_ref().unwrap(), "w")
+                .unwrap()
+                .program;
+            assert!(program.image_world().is_some(), "{interp} {cs} {proj}");
+            let env = Environment::new(&scene, Arc::new(program), Mat4::IDENTITY, None);
+            for k in 0..4000 {
+                let u = Vec2::new((k % 80) as f32 / 79.0, (k / 80) as f32 / 49.0);
+                let d = crate::sampling::square_to_uniform_sphere(u);
+                let by_program = env
+                    .program
+                    .emission(&background_globals(d, 2, 0), &env.shade_env(&scene));
+                let direct = env.radiance(&scene, d, 2, 0);
+                assert_eq!(
+                    direct.to_array().map(f32::to_bits),
+                    by_program.to_array().map(f32::to_bits),
+                    "{interp} {cs} {proj} {strength}: {d}"
+                );
+                checked += (direct != Vec3::ZERO) as usize;
+            }
+        }
+        assert!(checked > 10_000, "{checked}");
+        // A linked Vector is more than an image world.
+        let mut g = world("Linear", "Non-Color", "EQUIRECTANGULAR", 1.0);
+        let tc = g.add(crate::shading::Node::new("ShaderNodeTexCoord"));
+        g.nodes[0] = g.nodes[0].clone().link("Vector", tc, "Generated");
+        let program = crate::shading::compile(&g, "w").unwrap().program;
+        assert!(program.image_world().is_none());
     }
 
     #[test]

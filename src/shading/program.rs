@@ -202,6 +202,14 @@ impl Program {
         })
     }
 
+    /// The program as an [`nodes::environment::ImageWorld`], if that is all it computes.
+    pub fn image_world(&self) -> Option<nodes::environment::ImageWorld> {
+        if self.constant.is_some() || !self.may_emit {
+            return None;
+        }
+        nodes::environment::ImageWorld::recognise(&self.ops, &self.init)
+    }
+
     /// True when the program may emit light somewhere.
     pub fn may_emit(&self) -> bool {
         self.may_emit

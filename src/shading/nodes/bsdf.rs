@@ -198,6 +198,14 @@ impl ClosureOp {
         }
     }
 
+    /// `(weight, color, strength)` of an emission closure.
+    pub fn as_emission(&self) -> Option<(Slot, Slot, Slot)> {
+        match self.params {
+            ClosureParams::Emission { color, strength } => Some((self.weight, color, strength)),
+            _ => None,
+        }
+    }
+
     #[inline]
     pub fn eval(&self, s: &mut Slots, g: &ShaderGlobals, out: &mut ClosureSet) {
         let w = s.f(self.weight);

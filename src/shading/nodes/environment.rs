@@ -6,12 +6,12 @@
 
 use super::bsdf::ClosureOp;
 use super::input::{InputOp, Source};
-use crate::scene::{Texture, Wrap};
+use crate::scene::{Image, Texture, Wrap};
 use crate::shading::compile::{CompileError, NodeCx, SocketType};
 use crate::shading::globals::{ShadeEnv, ShaderGlobals};
 use crate::shading::program::{Op, Slot, Slots};
 use crate::texture;
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 use std::f32::consts::PI;
 
 /// Blender-world direction → Cycles' equirectangular `(u, v)` (`v = 0` at the bottom of the
@@ -81,10 +81,16 @@ impl EnvironmentOp {
     #[inline]
     pub fn eval(&self, s: &mut Slots, g: &ShaderGlobals, env: &ShadeEnv) {
         let v = self.vector.map_or(g.p, |v| s.v(v));
-        let Some(img) = env.images.get(self.image) else {
-            s.set_v(self.color, Vec3::new(1.0, 0.0, 1.0));
-            s.set_f(self.alpha, 1.0);
-            return;
+        let c = self.color_at(v, env.images);
+        s.set_v(self.color, c.truncate());
+        s.set_f(self.alpha, c.w);
+    }
+
+    /// Colour and alpha towards `v` (Blender world, any length); magenta for a missing image.
+    #[inline(always)]
+    fn color_at(&self, v: Vec3, images: &[Image]) -> Vec4 {
+        let Some(img) = images.get(self.image) else {
+            return Vec4::new(1.0, 0.0, 1.0, 1.0);
         };
         let uv = if self.mirror_ball {
             let len = v.length();
@@ -98,9 +104,53 @@ impl EnvironmentOp {
             direction_to_equirectangular(v)
         };
         // Cycles' v runs up the image; the renderer's images run top to bottom.
-        let c = texture::lookup(&self.sampler, img, Vec2::new(uv.x, 1.0 - uv.y), self.srgb);
-        s.set_v(self.color, c.truncate());
-        s.set_f(self.alpha, c.w);
+        texture::lookup(&self.sampler, img, Vec2::new(uv.x, 1.0 - uv.y), self.srgb)
+    }
+}
+
+/// A world that is only an Environment Texture (its Vector unlinked: the view direction) into
+/// a Background of constant strength, as most HDRI worlds are: its emission found without
+/// running the program, by the same operations in the same order (so to the same bits).
+#[derive(Clone, Debug)]
+pub struct ImageWorld {
+    env: EnvironmentOp,
+    /// Background Strength and the closure's weight, constants of the program.
+    strength: f32,
+    weight: f32,
+}
+
+impl ImageWorld {
+    /// The world of `ops` with slot constants `init`, if it is an [`ImageWorld`].
+    pub(crate) fn recognise(ops: &[Op], init: &[f32]) -> Option<ImageWorld> {
+        let [Op::Environment(env), Op::Closure(closure)] = ops else {
+            return None;
+        };
+        let (weight, color, strength) = closure.as_emission()?;
+        let written = |s: Slot| (env.color..env.color + 3).contains(&s) || s == env.alpha;
+        if env.vector.is_some() || color != env.color || written(weight) || written(strength) {
+            return None;
+        }
+        Some(ImageWorld {
+            env: env.clone(),
+            strength: *init.get(strength as usize)?,
+            weight: *init.get(weight as usize)?,
+        })
+    }
+
+    /// The emission the program gives for a ray leaving along `d` (Blender world, unit), as
+    /// [`crate::shading::Program::emission`] finds it.
+    #[inline]
+    pub fn emission(&self, d: Vec3, images: &[Image]) -> Vec3 {
+        if self.weight == 0.0 {
+            return Vec3::ZERO;
+        }
+        let c = self.env.color_at(d, images).truncate();
+        let e = c.max(Vec3::ZERO) * self.strength * self.weight;
+        if e.is_finite() {
+            Vec3::ZERO + e.max(Vec3::ZERO)
+        } else {
+            Vec3::ZERO
+        }
     }
 }
 
