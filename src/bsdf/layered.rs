@@ -20,7 +20,7 @@
 use super::microfacet::Roughness;
 use super::rough_dielectric::RoughDielectric;
 use super::sheen::Sheen;
-use super::tables::{dielectric_reflection_albedo, ggx_e, reflection_fresnel_s};
+use super::tables::{dielectric_reflection_albedo, reflection_fresnel_s};
 use super::{
     Bsdf, BsdfQueryRecord, DELTA_ALPHA, Dielectric, Diffuse, Measure, Mirror, Plastic,
     RoughConductor, Translucent, fresnel,
@@ -160,10 +160,7 @@ impl Layer for RoughDielectric {
             f0 + (Vec3::ONE - f0) * s
         };
         let darkening = match self.multiscatter_fss {
-            Some(_) => {
-                let (e, _) = ggx_e(r.alpha_x, r.alpha_y, mu);
-                self.energy_factor(mu, self.ior) * e
-            }
+            Some(_) => self.energy_factor(mu, self.ior) * self.reflection_e(mu),
             None => Vec3::ONE,
         };
         self.reflection_tint * f * darkening

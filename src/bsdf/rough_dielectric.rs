@@ -62,8 +62,9 @@ pub struct RoughDielectric {
     pub transmission_tint: Vec3,
     /// `F_ss` of Cycles' energy compensation, when enabled ([`RoughDielectric::multiscatter`]).
     pub multiscatter_fss: Option<Vec3>,
-    /// `(cos θi, η, energy_factor)` found once for the shading point's incident direction.
-    energy_at: Option<(f32, f32, Vec3)>,
+    /// `(cos θi, η, energy_factor, E(cos θi))` found once for the shading point's incident
+    /// direction (`E` from the table the factor came from).
+    energy_at: Option<(f32, f32, Vec3, f32)>,
 }
 
 /// Relative index within this distance of 1 makes refraction a pass-through (Cycles treats it
@@ -146,18 +147,39 @@ impl RoughDielectric {
         let Some(fss) = self.multiscatter_fss else {
             return Vec3::ONE;
         };
-        if let Some((z, e, f)) = self.energy_at
+        if let Some((z, e, f, _)) = self.energy_at
             && z == wi_z
             && e == eta
         {
             return f;
         }
+        self.energy_terms(wi_z, eta, fss).0
+    }
+
+    /// `(energy_factor, E(wi_z))` with compensation `fss`.
+    #[inline]
+    fn energy_terms(&self, wi_z: f32, eta: f32, fss: Vec3) -> (Vec3, f32) {
         let a = &self.setup_roughness;
         let (e, e_avg) = match self.mode {
             DielectricMode::Glass => tables::ggx_glass_e((a.alpha_x * a.alpha_y).sqrt(), wi_z, eta),
             _ => tables::ggx_e(a.alpha_x, a.alpha_y, wi_z),
         };
-        tables::multiscatter_factor(e, e_avg, fss)
+        (tables::multiscatter_factor(e, e_avg, fss), e)
+    }
+
+    /// `E(μ)` of the white single-scattering GGX mirror of the setup roughness (a reflection
+    /// lobe's darkening as a layer), from the prepared values when they are for `μ`.
+    #[inline]
+    pub(crate) fn reflection_e(&self, mu: f32) -> f32 {
+        if let Some((z, eta, _, e)) = self.energy_at
+            && z == mu
+            && eta == self.ior
+            && self.mode == DielectricMode::Reflection
+        {
+            return e;
+        }
+        let r = &self.setup_roughness;
+        tables::ggx_e(r.alpha_x, r.alpha_y, mu).0
     }
 
     /// The same lobe with its alphas raised to at least `blur` (Cycles' Filter Glossy,
@@ -185,7 +207,11 @@ impl RoughDielectric {
         self.energy_at = None;
         let (flip, eta) = self.side(wi);
         let z = mirror(wi, flip).z;
-        self.energy_at = Some((z, eta, self.energy_factor(z, eta)));
+        let Some(fss) = self.multiscatter_fss else {
+            return;
+        };
+        let (f, e) = self.energy_terms(z, eta, fss);
+        self.energy_at = Some((z, eta, f, e));
     }
 
     /// Blender's Glass BSDF (GGX): Color tints reflection and refraction alike (Cycles sets
