@@ -133,3 +133,58 @@ def test_collection_instances_share_one_mesh(addon, tmp_path):
     dets = sorted(round(float(np.linalg.det(np.array(nd["matrix"]).reshape(4, 4)[:3, :3])), 3)
                   for nd in users)
     assert dets == [-1.0, 1.0, 1.0, 1.0], dets
+
+
+def particle_host_hidden():
+    """A plane emitting 30 hair particles rendered as small spheres, its own mesh hidden from
+    the render (Show Emitter off), over a lit floor: only the particles render (a hair
+    particle scales its object by the hair length: spheres of radius 0.12)."""
+    import bmesh
+
+    scenes.clear_scene()
+    me = bpy.data.meshes.new("Grid")
+    bm = bmesh.new()
+    bmesh.ops.create_grid(bm, x_segments=1, y_segments=1, size=1.5)
+    bm.to_mesh(me)
+    bm.free()
+    me.materials.append(scenes.lambert("HostMat", (0.8, 0.3, 0.2)))
+    host = bpy.data.objects.new("Host", me)
+    bpy.context.scene.collection.objects.link(host)
+    host.location.z = 0.2
+    # The instanced sphere itself stands out of view.
+    src = scenes.add_sphere("Src", (9.0, 9.0, 0.0), 0.6, scenes.lambert("S", (0.2, 0.6, 0.9)),
+                            segments=12, rings=6)
+    ps = host.modifiers.new("P", "PARTICLE_SYSTEM").particle_system
+    st = ps.settings
+    st.type = "HAIR"
+    st.count = 30
+    st.render_type = "OBJECT"
+    st.instance_object = src
+    st.hair_length = 0.2
+    st.particle_size = 1.0
+    host.show_instancer_for_render = False
+    scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
+                    scenes.lambert("F", (0.5, 0.5, 0.5)))
+    scenes.add_sun_light("Sun", (-0.3, 0.4, -1.0), 3.0)
+    scenes.add_camera((0.0, -3.5, 3.0), (0.0, 0.0, 0.2), fov=0.87)
+    return bpy.context.scene
+
+
+def test_hidden_particle_emitter_agrees_with_cycles(addon, tesela_bin, tmp_path, monkeypatch):
+    """Show Emitter off: Cycles renders the particles, not the emitting mesh (the depsgraph's
+    show_self); rendering the host plane too puts a red square over the floor."""
+    monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
+    scene = particle_host_hidden()
+    spp = 128
+    scenes.configure_cycles(scene, SIZE, SIZE, spp, 0, seed=7)
+    ref = imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
+    scene.render.engine = "TESELA"
+    t = scene.tesela
+    scenes.tesela_like_cycles(t)
+    t.integrator, t.samples, t.max_depth, t.seed = "direct_mis", spp, 2, 1
+    t.threads = int(os.environ.get("TESELA_TEST_THREADS", "0"))
+    assert bpy.ops.render.render() == {"FINISHED"}
+    got = result_pixels(tmp_path)
+    result = imgcompare.compare(got, ref, mean_tol=0.02, block_tol=0.05)
+    print(f"hidden particle emitter: {result}")
+    assert result.ok, f"hidden particle emitter: Tesela (add-on) vs Cycles: {result}"
