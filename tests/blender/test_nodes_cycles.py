@@ -437,6 +437,12 @@ for dims in ("1D", "2D", "3D", "4D"):
         case("white_noise-%s-%s" % (dims, output.lower()),
              tex("ShaderNodeTexWhiteNoise", output, {"noise_dimensions": dims}, vector=P3_BIG,
                  W=W_FIELD))
+# Unlinked, White Noise's Vector is (0, 0, 0), not the Generated coordinates of the other
+# textures: one colour all over (4D: varying with W only).
+case("white_noise-3D-color-unlinked",
+     tex("ShaderNodeTexWhiteNoise", "Color", {"noise_dimensions": "3D"}))
+case("white_noise-4D-value-unlinked",
+     tex("ShaderNodeTexWhiteNoise", "Value", {"noise_dimensions": "4D"}, W=W_FIELD))
 
 VORONOI = dict(Scale=3.0, Randomness=0.8)
 for dims in ("1D", "2D", "3D", "4D"):

@@ -1,6 +1,6 @@
 //! Procedural texture nodes (Noise, White Noise, Voronoi, Checker, Gradient, Wave, Magic,
 //! Brick, Gabor): the compile glue around the algorithms in [`crate::shading::tex`]. An unlinked
-//! Vector input reads Generated coordinates, as in Cycles.
+//! Vector input reads Generated coordinates, as in Cycles (White Noise's reads its zero default).
 
 use crate::shading::compile::{CompileError, NodeCx, SocketType};
 use crate::shading::program::{Op, Slot, Slots};
@@ -406,7 +406,9 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         // Three more noise evaluations: only when something reads the colour.
         *want_color = cx.wanted() != Some("Fac");
     }
-    let vector = if cx.is_linked("Vector") {
+    // White Noise is the one texture whose unlinked Vector is its zero default rather than
+    // the Generated coordinates (Cycles gives its socket no texture-coordinate link).
+    let vector = if cx.is_linked("Vector") || matches!(k, Kind::WhiteNoise { .. }) {
         cx.vector("Vector", Vec3::ZERO)?
     } else {
         let out = cx.alloc(3)?;
