@@ -4,6 +4,7 @@ modules (mesh, material, light, camera, world) for their parts and writes .gltf 
 
 import json
 import os
+import struct
 import time
 
 import numpy as np
@@ -356,11 +357,19 @@ def render_size(render):
             max(1, int(render.resolution_y * pct / 100)))
 
 
+def _f32_trunc(fraction, size):
+    """trunc(fraction * size) with the product rounded to single precision first (the double
+    product of a float32 and a pixel count is exact, so this is the float32 product)."""
+    return int(struct.unpack("f", struct.pack("f", fraction * size))[0])
+
+
 def border_region(render, width, height):
     """The border as (x, y, w, h), top-left origin, or None for the full frame.
 
     Blender's render result for a border spans pixels trunc(min * size) to trunc(max * size)
-    (Blender 5.0: a border of 0.2-0.6 on 64 pixels is 26 wide, not trunc(0.4 * 64) = 25).
+    (Blender 5.0: a border of 0.2-0.6 on 64 pixels is 26 wide, not trunc(0.4 * 64) = 25),
+    the products taken in single precision as Blender takes them (0.95 * 80 is 76, not the
+    75.99999 of double precision).
     """
     if not render.use_border:
         return None
@@ -368,10 +377,10 @@ def border_region(render, width, height):
     by0, by1 = sorted((render.border_min_y, render.border_max_y))
     bx0, by0 = max(0.0, bx0), max(0.0, by0)
     bx1, by1 = min(1.0, bx1), min(1.0, by1)
-    xmin = int(bx0 * width)
-    ymin = int(by0 * height)
-    w = int(bx1 * width) - xmin
-    h = int(by1 * height) - ymin
+    xmin = _f32_trunc(bx0, width)
+    ymin = _f32_trunc(by0, height)
+    w = _f32_trunc(bx1, width) - xmin
+    h = _f32_trunc(by1, height) - ymin
     w = max(1, min(w, width - xmin))
     h = max(1, min(h, height - ymin))
     if (xmin, ymin, w, h) == (0, 0, width, height):

@@ -320,23 +320,32 @@ def test_render_pixels_orientation_and_percentage(addon, fake, private_tmp, tmp_
     assert not pid_alive(run["pid"])
 
 
-@pytest.mark.parametrize("border", [(0.25, 0.75, 0.1, 0.5), (0.13, 0.61, 0.37, 0.93),
-                                    (0.2, 0.6, 0.2, 0.6)])
-def test_render_border(addon, fake, private_tmp, tmp_path, border):
-    scene = simple_scene(width=64, height=48, percentage=50)
+@pytest.mark.parametrize("border, size", [
+    ((0.25, 0.75, 0.1, 0.5), (64, 48, 50)),
+    ((0.13, 0.61, 0.37, 0.93), (64, 48, 50)),
+    ((0.2, 0.6, 0.2, 0.6), (64, 48, 50)),
+    # 0.95 * 80 is 76 in single precision (Blender's), 75.99999 in double.
+    ((0.55, 0.95, 0.05, 0.45), (80, 60, 100)),
+])
+def test_render_border(addon, fake, private_tmp, tmp_path, border, size):
+    width, height, percentage = size
+    scene = simple_scene(width=width, height=height, percentage=percentage)
     r = scene.render
     r.use_border = True
     r.border_min_x, r.border_max_x, r.border_min_y, r.border_max_y = border
     assert render() == {"FINISHED"}
     px = result_pixels(tmp_path)
-    W, H = 32, 24
+    W, H = width * percentage // 100, height * percentage // 100
     assert px.shape == (H, W, 4)
-    # Blender's border: pixels trunc(min * size) to trunc(max * size) (bottom-up), as Cycles
-    # fills them (0.1-0.5 of 24 rows is 10 rows, not trunc(0.4 * 24) = 9).
-    bw = int(border[1] * W) - int(border[0] * W)
-    bh = int(border[3] * H) - int(border[2] * H)
-    x0, x1 = int(border[0] * W), int(border[0] * W) + bw
-    y1 = H - int(border[2] * H)  # rows top to bottom
+    # Blender's border: pixels trunc(min * size) to trunc(max * size) (bottom-up), the products
+    # in single precision, as Cycles fills them (0.1-0.5 of 24 rows is 10 rows, not
+    # trunc(0.4 * 24) = 9).
+    def at(fraction, n):
+        return int(np.float32(fraction) * np.float32(n))
+    bw = at(border[1], W) - at(border[0], W)
+    bh = at(border[3], H) - at(border[2], H)
+    x0, x1 = at(border[0], W), at(border[0], W) + bw
+    y1 = H - at(border[2], H)  # rows top to bottom
     y0 = y1 - bh
     (run,) = fake()
     argv = run["argv"]
