@@ -507,6 +507,19 @@ def is_holdout(obj, view_layer):
     return bool(getattr(orig, "is_holdout", False))
 
 
+def is_indirect_only(obj, view_layer):
+    """Whether the object's collection is Indirect Only in `view_layer` (View Layer > Indirect
+    Only, 2.91+): Cycles then hides it from camera rays only."""
+    orig = getattr(obj, "original", obj) or obj
+    get = getattr(orig, "indirect_only_get", None)
+    if get is None or view_layer is None:
+        return False
+    try:
+        return bool(get(view_layer=view_layer))
+    except (TypeError, RuntimeError, ReferenceError):
+        return False
+
+
 def is_extension_platform():
     return VERSION >= (4, 2, 0)
 

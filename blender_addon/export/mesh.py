@@ -443,7 +443,8 @@ def random_number(rid):
 
 def object_extras(inst, obj, view_layer=None):
     """extras.tesela_object: what Object Info reads (Blender's world coordinates), the ray
-    visibility and whether the object is a holdout (its own or its instancer's)."""
+    visibility (Indirect Only clearing the camera's) and whether the object is a holdout (its
+    own or its instancer's)."""
     rid = random_id(inst, obj)
     m = inst.matrix_world
     out = {"random": random_number(rid), "random_id": rid,
@@ -457,9 +458,14 @@ def object_extras(inst, obj, view_layer=None):
     if instancer is not None:
         parent = compat.ray_visibility(instancer)
         vis = {k: v and parent[k] for k, v in vis.items()}
+    holdout = compat.is_holdout(obj, view_layer) or (
+        instancer is not None and compat.is_holdout(instancer, view_layer))
+    # Indirect Only (of the object, or of an instance's instancer, as Cycles reads it): the
+    # camera does not see it; everything else does.
+    if not holdout and compat.is_indirect_only(instancer or obj, view_layer):
+        vis["camera"] = False
     if not all(vis.values()):
         out["visibility"] = vis
-    if compat.is_holdout(obj, view_layer) or (
-            instancer is not None and compat.is_holdout(instancer, view_layer)):
+    if holdout:
         out["holdout"] = True
     return out

@@ -1,5 +1,6 @@
 """Object > Visibility > Ray Visibility against Cycles (PyPI bpy 5.x): objects hidden from the
-camera, from shadow rays, from diffuse, glossy or transmission rays, through the add-on."""
+camera, from shadow rays, from diffuse, glossy or transmission rays, and Indirect Only
+collections, through the add-on."""
 
 import json
 import math
@@ -70,8 +71,27 @@ def transmission():
     return scenes.SceneInfo(bpy.context.scene, "transmission")
 
 
+def indirect_only():
+    """A red ball and a large white card in a View Layer > Indirect Only collection: the
+    camera sees neither (the back wall shows through the card), their shadows and the light
+    they bounce stay."""
+    _stage(lambda: scenes.lambert("Floor", (0.8, 0.8, 0.8)))
+    ball = scenes.add_sphere("Ball", (-0.8, 0.0, 0.5), 0.5, scenes.lambert("Red", (0.8, 0.1, 0.1)))
+    card = scenes.add_quad("Card", [(0.2, -0.6, 0.0), (1.4, 0.2, 0.0), (1.4, 0.2, 1.6),
+                                    (0.2, -0.6, 1.6)], scenes.lambert("White", (0.9, 0.9, 0.9)))
+    coll = bpy.data.collections.new("Indirect")
+    bpy.context.scene.collection.children.link(coll)
+    for ob in (ball, card):
+        for c in list(ob.users_collection):
+            c.objects.unlink(ob)
+        coll.objects.link(ob)
+    bpy.context.view_layer.layer_collection.children["Indirect"].indirect_only = True
+    return scenes.SceneInfo(bpy.context.scene, "indirect_only")
+
+
 CASES = [
     ("camera_and_shadow", camera_and_shadow, 2, "path_mis", 512),
+    ("indirect_only", indirect_only, 2, "path_mis", 512),
     ("glossy_and_diffuse", glossy_and_diffuse, 2, "path_mis", 512),
     ("transmission", transmission, 4, "path_mis", 512),
 ]
