@@ -507,6 +507,15 @@ def is_holdout(obj, view_layer):
     return bool(getattr(orig, "is_holdout", False))
 
 
+def row_is_geometry(obj):
+    """Whether a depsgraph row's object renders as geometry: only rows whose data is a Mesh (as
+    Cycles' object_is_geometry). A curve, text, surface or metaball object's own row carries
+    its curve data; its evaluated mesh follows as an instance row of its own (3.0+ geometry
+    sets; seen in 3.4 and 5.x), which is the one to export."""
+    rna = getattr(getattr(obj, "data", None), "rna_type", None)
+    return rna is None or rna.identifier == "Mesh"
+
+
 def is_indirect_only(obj, view_layer):
     """Whether the object's collection is Indirect Only in `view_layer` (View Layer > Indirect
     Only, 2.91+): Cycles then hides it from camera rays only."""

@@ -233,6 +233,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             elif orig.name not in selection:
                 continue
         otype = obj.type
+        if otype in MESHLIKE and not compat.row_is_geometry(obj):
+            continue
         if otype in MESHLIKE and not getattr(inst, "show_self", True):
             # A particle system's emitter with Show Emitter off for this mode: only its
             # particles render (as Cycles reads the instance's show_self).

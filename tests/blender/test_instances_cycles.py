@@ -188,3 +188,81 @@ def test_hidden_particle_emitter_agrees_with_cycles(addon, tesela_bin, tmp_path,
     result = imgcompare.compare(got, ref, mean_tol=0.02, block_tol=0.05)
     print(f"hidden particle emitter: {result}")
     assert result.ok, f"hidden particle emitter: Tesela (add-on) vs Cycles: {result}"
+
+
+def curve_text_meta_surface():
+    """A bevelled Bezier circle, a text, a metaball and a NURBS sphere: objects whose evaluated
+    mesh the depsgraph yields as an instance row after the object's own (curve data) row."""
+    scenes.clear_scene()
+    bpy.ops.curve.primitive_bezier_circle_add(location=(0.0, 0.0, 0.3))
+    bpy.context.active_object.data.bevel_depth = 0.1
+    bpy.ops.object.text_add(location=(1.5, 0.0, 0.0))
+    bpy.ops.object.metaball_add(location=(-1.5, 0.0, 0.5))
+    bpy.ops.surface.primitive_nurbs_surface_sphere_add(radius=0.4, location=(0.0, 1.5, 0.5))
+    bpy.context.view_layer.update()
+
+
+def test_curve_text_metaball_and_surface_export_their_mesh_once(addon, tmp_path):
+    """Cycles renders only the mesh rows of the depsgraph; the objects' own rows carry curve
+    data (exporting them too doubled every triangle)."""
+    curve_text_meta_surface()
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    want = 0
+    for inst in depsgraph.object_instances:
+        if inst.object.type == "MESH":
+            me = inst.object.to_mesh()
+            me.calc_loop_triangles()
+            want += len(me.loop_triangles)
+            inst.object.to_mesh_clear()
+    assert want > 1000
+    res = write_gltf(depsgraph, str(tmp_path / "c.gltf"), width=SIZE, height=SIZE)
+    assert res.triangles == want
+
+
+def gn_pipe():
+    """A Bezier curve made a pipe by Geometry Nodes (Curve to Mesh with a Curve Circle, Set
+    Material orange) over the lit plane: the curve object itself has no material slots."""
+    info = scenes.light_over_plane("point", with_box=False)
+    cu = bpy.data.curves.new("Path", "CURVE")
+    cu.dimensions = "3D"
+    s = cu.splines.new("BEZIER")
+    s.bezier_points.add(2)
+    for bp, p in zip(s.bezier_points, [(-1.2, 0, 0.2), (0, 0.4, 1.0), (1.2, -0.2, 0.2)]):
+        bp.co = p
+        bp.handle_left_type = bp.handle_right_type = "AUTO"
+    ob = bpy.data.objects.new("Path", cu)
+    bpy.context.scene.collection.objects.link(ob)
+    ng = bpy.data.node_groups.new("Pipe", "GeometryNodeTree")
+    ng.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    ng.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    n = ng.nodes
+    gin, gout = n.new("NodeGroupInput"), n.new("NodeGroupOutput")
+    cc = n.new("GeometryNodeCurvePrimitiveCircle")
+    cc.inputs["Radius"].default_value = 0.1
+    c2m = n.new("GeometryNodeCurveToMesh")
+    sm = n.new("GeometryNodeSetMaterial")
+    sm.inputs["Material"].default_value = scenes.lambert("PipeM", (0.9, 0.4, 0.2))
+    ng.links.new(gin.outputs["Geometry"], c2m.inputs["Curve"])
+    ng.links.new(cc.outputs[0], c2m.inputs["Profile Curve"])
+    ng.links.new(c2m.outputs[0], sm.inputs[0])
+    ng.links.new(sm.outputs[0], gout.inputs[0])
+    ob.modifiers.new("Pipe", "NODES").node_group = ng
+    return info
+
+
+def test_geometry_nodes_pipe_agrees_with_cycles(addon, tesela_bin, tmp_path, monkeypatch):
+    monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
+    scene = gn_pipe().scene
+    spp = 128
+    scenes.configure_cycles(scene, SIZE, SIZE, spp, 0, seed=7)
+    ref = imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
+    scene.render.engine = "TESELA"
+    t = scene.tesela
+    scenes.tesela_like_cycles(t)
+    t.integrator, t.samples, t.max_depth, t.seed = "direct_mis", spp, 2, 1
+    t.threads = int(os.environ.get("TESELA_TEST_THREADS", "0"))
+    assert bpy.ops.render.render() == {"FINISHED"}
+    got = result_pixels(tmp_path)
+    result = imgcompare.compare(got, ref, mean_tol=0.02, block_tol=0.05)
+    print(f"geometry nodes pipe: {result}")
+    assert result.ok, f"geometry nodes pipe: Tesela (add-on) vs Cycles: {result}"
