@@ -179,6 +179,9 @@ pub struct Ctx {
     /// Path vertex the current ray leads to (1: a camera ray), set by the integrators'
     /// `trace_emitted`: what the world's Light Path node reads as the ray depth.
     pub depth: u32,
+    /// The current path's bounces of each kind, kept by the path integrators (zero for
+    /// the others): what shading programs read as the Light Path depths.
+    pub depths: crate::shading::globals::PathDepths,
     /// Rays cast: camera, bounce and shadow rays, and the last segments of paths however
     /// they are answered ([`RenderScene::emission_along`] may need no traversal at all).
     pub rays: u64,
@@ -210,7 +213,25 @@ pub struct Ctx {
     pub medium: Medium,
 }
 
+/// A path vertex's index and the path's bounces of each kind before it: what an emitter's
+/// shader reads as its Light Path depths.
+pub type PathAt = (u32, crate::shading::globals::PathDepths);
+
 impl Ctx {
+    /// Where the current ray's hit is on the path: vertex [`Ctx::depth`] after the bounces
+    /// counted so far.
+    #[inline]
+    pub fn path_at(&self) -> PathAt {
+        (self.depth, self.depths)
+    }
+
+    /// What a light sample from the current vertex sees: the next vertex, the same bounces
+    /// (Cycles counts a light sample's vertex one bounce further, its kinds not).
+    #[inline]
+    pub fn light_sample_at(&self) -> PathAt {
+        (self.depth + 1, self.depths)
+    }
+
     /// A context with `sampler`, no rays counted, not recording.
     pub fn new(sampler: crate::sampler::SobolSampler) -> Ctx {
         Ctx {
@@ -218,6 +239,7 @@ impl Ctx {
             shade: Default::default(),
             ray_flags: 0,
             depth: 1,
+            depths: Default::default(),
             rays: 0,
             log: None,
             trav: Traversal::default(),
@@ -1065,13 +1087,13 @@ impl RenderScene {
             return self.emission_through(ctx, o, d);
         }
         let Some(emissive) = &self.emitter_accel else {
-            let (depth, flags) = (ctx.depth, ctx.ray_flags);
-            return self.emission_at(self.intersect(ctx, o, d).as_ref(), o, d, depth, flags);
+            let (path, flags) = (ctx.path_at(), ctx.ray_flags);
+            return self.emission_at(self.intersect(ctx, o, d).as_ref(), o, d, path, flags);
         };
         ctx.cast(o, d, f32::INFINITY, RayKind::Emission);
         if let Some(hit) = emissive.intersect_with(&mut ctx.trav, o, d, 0.0, f32::INFINITY) {
             let its = self.intersection(&hit, d);
-            let (e, le, rec) = self.emitted(&its, o, ctx.ray_flags)?;
+            let (e, le, rec) = self.emitted(&its, o, ctx.ray_flags, ctx.path_at())?;
             if le == Vec3::ZERO {
                 return None;
             }
@@ -1103,7 +1125,7 @@ impl RenderScene {
                 tr *= medium::transmittance(m.sigma_t(), t);
             }
             let (e, le, rec) = match &hit {
-                Some(its) => match self.emitted(its, o, ctx.ray_flags) {
+                Some(its) => match self.emitted(its, o, ctx.ray_flags, ctx.path_at()) {
                     Some(x) => x,
                     None => (0, Vec3::ZERO, EmitterQueryRecord::default()),
                 },
@@ -1345,6 +1367,7 @@ impl RenderScene {
             // About a tenth of a pixel at a typical field of view.
             bump_step: its.t.max(1e-3) * 1e-4,
             ray_depth: depth,
+            depths: Default::default(),
             ray_length: its.t,
             ray_flags: flags,
             object: [its.mesh, its.instance],
@@ -1400,7 +1423,8 @@ impl RenderScene {
                 } else {
                     ctx.ray_flags
                 };
-                let g = self.globals(its, d, depth, flags);
+                let mut g = self.globals(its, d, depth, flags);
+                g.depths = ctx.depths;
                 let env = self.shade_env();
                 program.eval(&g, &env, &mut ctx.shade)
             }
@@ -1427,15 +1451,17 @@ impl RenderScene {
     }
 
     /// Radiance emitted by the hit surface towards `from` (the ray's origin) along a ray of
-    /// Light Path bits `flags`, with the emitter's index for MIS.
+    /// Light Path bits `flags`, the hit being path vertex `path.0` after the bounces `path.1`,
+    /// with the emitter's index for MIS.
     #[inline]
-    pub fn emitted(&self, its: &Intersection, from: Vec3, flags: u32) -> Emitted {
+    pub fn emitted(&self, its: &Intersection, from: Vec3, flags: u32, path: PathAt) -> Emitted {
         let e = its.emitter?;
         if flags & crate::shading::globals::ray::CAMERA != 0 && self.holdout_at(its) {
             return None;
         }
         let mut rec = EmitterQueryRecord::between(from, its.p, its.ns, its.ng, its.uv);
         rec.ray_flags = flags;
+        (rec.depth, rec.depths) = path;
         rec.tri = its.tri;
         rec.bary = Vec2::new(its.b1, its.b2);
         let le = self.emitters[e as usize].eval(&self.scene, &rec);
@@ -1451,11 +1477,11 @@ impl RenderScene {
         hit: Option<&Intersection>,
         o: Vec3,
         d: Vec3,
-        depth: u32,
+        (depth, depths): PathAt,
         flags: u32,
     ) -> Emitted {
         match hit {
-            Some(its) => self.emitted(its, o, flags),
+            Some(its) => self.emitted(its, o, flags, (depth, depths)),
             None => self.background_radiance(d, o, depth, flags),
         }
     }
@@ -1543,16 +1569,19 @@ impl RenderScene {
             * self.emitters[emitter as usize].pdf(&self.scene, rec)
     }
 
-    /// Chooses an emitter and samples it from `ref_p`. Returns the record and the weight
-    /// `Le / (pmf · pdf)` (zero when no light could be sampled).
+    /// Chooses an emitter and samples it from `ref_p`, the path being at the vertex and
+    /// bounces `path` its emitter's shader sees ([`Ctx::light_sample_at`]). Returns the record
+    /// and the weight `Le / (pmf · pdf)` (zero when no light could be sampled).
     #[inline]
     pub fn sample_light(
         &self,
         ref_p: Vec3,
         u_choice: f32,
         u: Vec2,
+        (depth, depths): PathAt,
     ) -> (u32, EmitterQueryRecord, Vec3) {
         let mut rec = EmitterQueryRecord::from_ref(ref_p);
+        (rec.depth, rec.depths) = (depth, depths);
         let Some((i, pmf)) = self.lights.sample_at(ref_p, u_choice) else {
             return (0, rec, Vec3::ZERO);
         };
@@ -1841,7 +1870,7 @@ mod tests {
             let its = rs
                 .intersect(&mut ctx, ref_p, rec.wi)
                 .expect("the ray hits the light");
-            let (_, hit, _) = rs.emitted(&its, ref_p, 0).unwrap();
+            let (_, hit, _) = rs.emitted(&its, ref_p, 0, (1, Default::default())).unwrap();
             let backfacing = ng.dot(rec.wi) > 0.0;
             let expected = to_blender(-rec.wi).abs() * if backfacing { 2.0 } else { 1.0 };
             let tol = 1e-4 * expected.max_element();
@@ -1887,7 +1916,7 @@ mod tests {
                 let d = square_to_uniform_sphere(rng.next_2d());
                 let fast = rs.emission_along(&mut ctx, o, d);
                 let hit = rs.intersect(&mut ctx, o, d);
-                let full = rs.emission_at(hit.as_ref(), o, d, ctx.depth, ctx.ray_flags);
+                let full = rs.emission_at(hit.as_ref(), o, d, ctx.path_at(), ctx.ray_flags);
                 let full = full.filter(|(_, le, _)| *le != Vec3::ZERO);
                 match (&fast, &full) {
                     (Some((a, la, ra)), Some((b, lb, rb))) => {

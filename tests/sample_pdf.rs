@@ -698,7 +698,8 @@ fn light_choice_is_folded_into_the_reported_pdf() {
         let mut rng = Sampler::new(400, 0, 0);
         for _ in 0..20_000 {
             let ref_p = v(4.0, 2.0, 4.0) * (rng.next_2d().extend(rng.next_1d()) - 0.5);
-            let (i, rec, w) = rs.sample_light(ref_p, rng.next_1d(), rng.next_2d());
+            let (i, rec, w) =
+                rs.sample_light(ref_p, rng.next_1d(), rng.next_2d(), (2, Default::default()));
             let e = &rs.emitters[i as usize];
             let pmf = rs.lights.pmf(i as usize);
             assert!(pmf > 0.0);

@@ -220,6 +220,8 @@ fn radiance(
             g.backfacing = backfacing;
             g.ray_length = rec.dist;
             g.ray_flags = rec.ray_flags;
+            g.ray_depth = rec.depth.max(1);
+            g.depths = rec.depths;
             g.bump_step = rec.dist.max(1e-3) * 1e-4;
             g
         }

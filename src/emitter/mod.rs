@@ -54,6 +54,12 @@ pub struct EmitterQueryRecord {
     /// Light Path bits the emitter's shader sees: none for light sampling (as Cycles
     /// evaluates emission for its light samples), the ray's own for a ray that hits it.
     pub ray_flags: u32,
+    /// The path vertex the emitter's point is, for its shader's Light Path Ray Depth (1: seen
+    /// from the camera; 0 counts as 1), and the path's bounces of each kind before it: as
+    /// Cycles, a light sample from vertex `k` sees vertex `k + 1` and the bounces made
+    /// before `k`.
+    pub depth: u32,
+    pub depths: crate::shading::globals::PathDepths,
 }
 
 impl EmitterQueryRecord {
@@ -81,6 +87,8 @@ impl EmitterQueryRecord {
             dist,
             pdf: 0.0,
             ray_flags: 0,
+            depth: 0,
+            depths: Default::default(),
         }
     }
 

@@ -97,8 +97,12 @@ impl DataContext<'_> {
             };
             let want_albedo = !data_done && set.contains(Pass::DenoisingAlbedo);
             if (want_emission || want_albedo)
-                && let Some((_, le, _)) =
-                    scene.emitted(&its, o, crate::shading::globals::ray::CAMERA)
+                && let Some((_, le, _)) = scene.emitted(
+                    &its,
+                    o,
+                    crate::shading::globals::ray::CAMERA,
+                    (1, Default::default()),
+                )
             {
                 if want_emission {
                     emission += tr * le;

@@ -119,6 +119,20 @@ impl BounceCount {
     }
 }
 
+impl BounceCount {
+    /// The counts as Light Path's depths, with `transparent` straight pass-throughs.
+    #[inline]
+    pub fn depths(&self, transparent: u32) -> crate::shading::globals::PathDepths {
+        let d = |n: u32| n.min(u16::MAX as u32) as u16;
+        crate::shading::globals::PathDepths {
+            diffuse: d(self.diffuse),
+            glossy: d(self.glossy),
+            transmission: d(self.transmission),
+            transparent: d(transparent),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -748,7 +748,7 @@ pub fn sample_emitter_towards(
     let none = (Vec3::ZERO, Vec3::ZERO);
     let uc = ctx.sampler.next_1d();
     let u = ctx.sampler.next_2d();
-    let (light, rec, weight) = scene.sample_light(its.p, uc, u);
+    let (light, rec, weight) = scene.sample_light(its.p, uc, u, ctx.light_sample_at());
     if weight == Vec3::ZERO || !scene.light_reaches(light, sp.light_class()) {
         return none;
     }
@@ -801,7 +801,7 @@ pub fn trace_emitted(
     } else {
         ctx.ray_flags
     };
-    let emitted = scene.emission_at(hit.as_ref(), o, d, depth, flags);
+    let emitted = scene.emission_at(hit.as_ref(), o, d, ctx.path_at(), flags);
     (hit, emitted)
 }
 

@@ -107,7 +107,7 @@ fn through_medium<S: Sink>(
 fn sample_emitter_in_medium(scene: &RenderScene, ctx: &mut Ctx, p: Vec3, d: Vec3) -> Vec3 {
     let uc = ctx.sampler.next_1d();
     let u = ctx.sampler.next_2d();
-    let (light, rec, weight) = scene.sample_light(p, uc, u);
+    let (light, rec, weight) = scene.sample_light(p, uc, u, ctx.light_sample_at());
     if weight == Vec3::ZERO {
         return Vec3::ZERO;
     }
@@ -185,6 +185,7 @@ impl PathMats {
         let mut depth = 1;
         let mut transparent = 0;
         let (mut counts, mut end) = (BounceCount::default(), self.max_depth);
+        ctx.depths = Default::default();
         ctx.no_caustics = self.paths.no_caustics();
         // Least BSDF density of the path's non-delta bounces (Filter Glossy).
         let mut min_ray_pdf = f32::INFINITY;
@@ -229,6 +230,7 @@ impl PathMats {
                 if counts.count(ctx.ray_flags, &self.paths) {
                     end = end.min(depth + 1);
                 }
+                ctx.depths = counts.depths(transparent);
                 (o, d) = (p, wo);
                 depth += 1;
                 continue;
@@ -249,6 +251,7 @@ impl PathMats {
                 // Straight through a transparent closure: not a bounce (Cycles counts these
                 // separately, up to its default of 8).
                 transparent += 1;
+                ctx.depths = counts.depths(transparent);
                 if transparent > self.paths.transparent {
                     return l;
                 }
@@ -291,6 +294,7 @@ impl PathMats {
             if counts.count(ctx.ray_flags, &self.paths) {
                 end = end.min(depth + 1);
             }
+            ctx.depths = counts.depths(transparent);
             if scene.absorbs {
                 ctx.medium = medium::after(scene, its, dv, wo, ctx.medium);
             }
@@ -340,6 +344,7 @@ impl PathMis {
         let mut bsdf_pdf = f32::INFINITY;
         ctx.mis_from = None;
         let (mut counts, mut end) = (BounceCount::default(), self.max_depth);
+        ctx.depths = Default::default();
         ctx.no_caustics = self.paths.no_caustics();
         // Least BSDF density of the path's non-delta bounces (Filter Glossy).
         let mut min_ray_pdf = f32::INFINITY;
@@ -397,6 +402,7 @@ impl PathMis {
                 if counts.count(ctx.ray_flags, &self.paths) {
                     end = end.min(depth + 1);
                 }
+                ctx.depths = counts.depths(transparent);
                 (o, d) = (p, wo);
                 depth += 1;
                 continue;
@@ -417,6 +423,7 @@ impl PathMis {
                 // Straight through a transparent closure: not a bounce (Cycles counts these
                 // separately, up to its default of 8).
                 transparent += 1;
+                ctx.depths = counts.depths(transparent);
                 if transparent > self.paths.transparent {
                     return l;
                 }
@@ -479,6 +486,7 @@ impl PathMis {
             if counts.count(ctx.ray_flags, &self.paths) {
                 end = end.min(depth + 1);
             }
+            ctx.depths = counts.depths(transparent);
             if scene.absorbs {
                 ctx.medium = medium::after(scene, its, dv, wo, ctx.medium);
             }

@@ -107,6 +107,8 @@ pub struct ShaderGlobals<'a> {
     pub bump_step: f32,
     /// Path vertex index of the point (1 = seen from the camera).
     pub ray_depth: u32,
+    /// The path's bounces of each kind before the point.
+    pub depths: PathDepths,
     /// Distance from the ray's origin to the point (Light Path's Ray Length; 0 without a ray).
     pub ray_length: f32,
     pub ray_flags: u32,
@@ -115,6 +117,18 @@ pub struct ShaderGlobals<'a> {
     /// Scrambles the random numbers of the rays the program casts at this point; kept by the
     /// Bump node's offset points so their rays agree.
     pub seed: u32,
+}
+
+/// Bounces of each kind a path has made before the current vertex, as Cycles' path state
+/// counts them (what Light Path's Diffuse, Glossy, Transmission and Transparent Depth read): a
+/// scattering bounce counts as transmission when it crosses the surface, else as diffuse or
+/// glossy; passing straight through a transparent surface counts as transparent.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PathDepths {
+    pub diffuse: u16,
+    pub glossy: u16,
+    pub transmission: u16,
+    pub transparent: u16,
 }
 
 impl<'a> ShaderGlobals<'a> {
@@ -136,6 +150,7 @@ impl<'a> ShaderGlobals<'a> {
             uv0,
             bump_step: 1e-4,
             ray_depth: 1,
+            depths: PathDepths::default(),
             ray_length: 0.0,
             ray_flags: ray::CAMERA,
             object: [u32::MAX; 2],

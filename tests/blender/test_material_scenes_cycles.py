@@ -810,7 +810,68 @@ LOWPOLY_REASON = (
     "p95 0.051. Raising interpolated normals too matched this scene (p95 0.015) but moved the "
     "Cornell light passes' Glossy Direct off Cycles' (p95 0.037 -> 0.08), so it is not on yet")
 
+def light_path_emitter(output):
+    """Emission 0.2 + the Light Path output ``output`` (a depth), as a Math Multiply Add."""
+    mat, nt, out = node_material("LightPath" + output.replace(" ", ""))
+    lp = node(nt, "ShaderNodeLightPath")
+    m = node(nt, "ShaderNodeMath", {"operation": "MULTIPLY_ADD"}, Value=lp.outputs[output])
+    m.inputs[1].default_value = 1.0
+    m.inputs[2].default_value = 0.2
+    surface(nt, out, node(nt, "ShaderNodeEmission", Color=m.outputs[0], Strength=1.0).outputs[0])
+    return mat
+
+
+def light_path_depths_in_mirror():
+    """Two emissive walls whose colour is 0.2 + Ray Depth (left) and 0.2 + Glossy Depth
+    (right), seen directly and in a perfect mirror floor: 0.2 direct, 1.2 mirrored (Cycles
+    counts the mirror bounce)."""
+    scenes.clear_scene()
+    scenes.add_quad("Mirror", [(-2, -2, 0), (2, -2, 0), (2, 2, 0), (-2, 2, 0)], scenes.mirror("M"))
+    for name, output, x0, x1 in (("Left", "Ray Depth", -2, 0), ("Right", "Glossy Depth", 0, 2)):
+        scenes.add_quad(name, [(x0, 1.5, 0.0), (x1, 1.5, 0.0), (x1, 1.5, 3), (x0, 1.5, 3)],
+                        light_path_emitter(output))
+    scenes.add_camera((0, -1.0, 0.5), (0, 1.0, 0.0), fov=math.radians(50))
+
+
+def light_path_depth_lighting():
+    """An emissive ball of colour 0.2 + Ray Depth lighting a diffuse floor: the floor is lit
+    by 1.2 (light samples and bounce rays reach the ball one bounce in), the camera sees 0.2."""
+    scenes.clear_scene()
+    scenes.add_quad("Floor", [(-2, -2, 0), (2, -2, 0), (2, 2, 0), (-2, 2, 0)],
+                    scenes.lambert("D", (0.8, 0.8, 0.8)))
+    scenes.add_sphere("Ball", (0, 0.5, 0.5), 0.4, light_path_emitter("Ray Depth"))
+    scenes.add_camera((0, -2.5, 0.3), (0, 0.0, 0.2), fov=math.radians(50))
+
+
+def transparent_depth_stack():
+    """Four stacked planes, each Mix(Emission, Transparent, 0.7) coloured by a ramp over 0.25
+    x Transparent Depth, seen from above: each plane farther down the stack is bluer."""
+    scenes.clear_scene()
+    mat, nt, out = node_material("TransparentDepth")
+    lp = node(nt, "ShaderNodeLightPath")
+    m = node(nt, "ShaderNodeMath", {"operation": "MULTIPLY"}, Value=lp.outputs["Transparent Depth"])
+    m.inputs[1].default_value = 0.25
+    ramp = node(nt, "ShaderNodeValToRGB", Fac=m.outputs[0])
+    ramp.color_ramp.elements[0].color = (1.0, 0.2, 0.1, 1.0)
+    ramp.color_ramp.elements[1].color = (0.1, 0.3, 1.0, 1.0)
+    em = node(nt, "ShaderNodeEmission", Color=ramp.outputs["Color"], Strength=1.0)
+    tr = node(nt, "ShaderNodeBsdfTransparent")
+    mix = node(nt, "ShaderNodeMixShader", Fac=0.7)
+    nt.links.new(em.outputs[0], mix.inputs[1])
+    nt.links.new(tr.outputs[0], mix.inputs[2])
+    surface(nt, out, mix.outputs[0])
+    for i in range(4):
+        z, o = 0.2 + 0.3 * i, 0.15 * i
+        scenes.add_quad("Q%d" % i, [(-1 + o, -1 + o, z), (1, -1 + o, z), (1, 1, z), (-1 + o, 1, z)],
+                        mat)
+    scenes.add_camera((0, 0, 5), (0, 0, 0), ortho_scale=2.2)
+    world(0.5)
+
+
 CASES = [
+    ("light_path_depths_in_mirror", light_path_depths_in_mirror, 2, 16, 64),
+    ("light_path_depth_lighting", light_path_depth_lighting, 2, 256, 1024),
+    ("transparent_depth_stack", transparent_depth_stack, 2, 64, 256),
     ("packed_roughness_metallic", packed_rough_metal, 0, 256, 1024),
     ("normal_map_gentle_lambert", lambda: normal_map(0.02, (-0.3, 0.2, -1.0), 0.0), 0, 128, 512),
     ("normal_map_gentle_principled", lambda: normal_map(0.02, (-0.3, 0.2, -1.0)), 0, 128, 512),

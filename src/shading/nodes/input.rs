@@ -34,6 +34,8 @@ pub enum Source {
     /// Light Path flag bit.
     RayFlag(u32),
     RayDepth,
+    /// Light Path's Diffuse (0), Glossy (1), Transmission (2) or Transparent (3) Depth.
+    KindDepth(u8),
     RayLength,
     /// Colour attribute by name: `(name, alpha?)`.
     Color(String, bool),
@@ -147,6 +149,11 @@ impl InputOp {
             Source::ObjectRandom => s.set_f(self.out, info.map_or(0.0, |o| o.random)),
             Source::RayFlag(bit) => s.set_f(self.out, flag(g.ray_flags & bit != 0)),
             Source::RayDepth => s.set_f(self.out, g.ray_depth.saturating_sub(1) as f32),
+            Source::KindDepth(kind) => {
+                let d = &g.depths;
+                let n = [d.diffuse, d.glossy, d.transmission, d.transparent][*kind as usize & 3];
+                s.set_f(self.out, n as f32)
+            }
             Source::RayLength => s.set_f(self.out, g.ray_length),
             Source::Color(name, alpha) => {
                 let c = g.color_attribute(name).unwrap_or(glam::Vec4::ZERO);
@@ -288,16 +295,17 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             }
             emit(cx, "Ray Depth", Float, Source::RayDepth)?;
             emit(cx, "Ray Length", Float, Source::RayLength)?;
-            let zero = cx.constant(&[0.0])?;
-            for id in [
-                "Diffuse Depth",
-                "Glossy Depth",
-                "Transparent Depth",
-                "Transmission Depth",
-                "Portal Depth",
+            for (id, kind) in [
+                ("Diffuse Depth", 0),
+                ("Glossy Depth", 1),
+                ("Transmission Depth", 2),
+                ("Transparent Depth", 3),
             ] {
-                cx.alias(id, zero, Float);
+                emit(cx, id, Float, Source::KindDepth(kind))?;
             }
+            // Portals guide only Cycles' world sampling; no path passes one here.
+            let zero = cx.constant(&[0.0])?;
+            cx.alias("Portal Depth", zero, Float);
         }
         "ShaderNodeVertexColor" => {
             let name = cx.prop_str("layer_name").unwrap_or("").to_string();
