@@ -192,13 +192,23 @@ impl ShadingPoint {
             if n.dot(its.ns) < 0.0 {
                 n = -n;
             }
-        } else if closure.normal == Vec3::ZERO && n.dot(-d) < 0.0 {
-            // The interpolated normal on the viewer's side; a closure's own normal already
-            // is Cycles' N (flipped with the face), and stays as mapped even where it turns
-            // away from the viewer.
+        } else if closure.normal == Vec3::ZERO
+            && (its.ng.dot(-d) < 0.0 || (n.dot(-d) < 0.0 && !keeps_turned_normal(&bsdf)))
+        {
+            // The interpolated normal flipped with the face (`its.ng` lies on its side), as
+            // Cycles' N; like a closure's own normal, it stays as it is where it turns away
+            // from the viewer on a face seen from the front (a diffuse lobe still lights it),
+            // for the lobes that shade such a normal as Cycles does.
             n = -n;
         }
-        if closure.normal != Vec3::ZERO
+        // Specular lobes reflect above the geometric surface (Cycles' valid specular
+        // reflection) under a closure normal, and under an interpolated one turned away from
+        // the viewer, which is then their bump-shadowing reference as a closure normal's
+        // surface is.
+        let turned_away =
+            !bsdf.is_transmissive() && closure.normal == Vec3::ZERO && n.dot(-d) < 0.0;
+        let raise = closure.normal != Vec3::ZERO || turned_away;
+        if raise
             && matches!(
                 bsdf,
                 BsdfInstance::Mirror(_)
@@ -237,7 +247,7 @@ impl ShadingPoint {
         let frame = frame_of(n);
         let glossy_frame = match &bsdf {
             BsdfInstance::Layered(l)
-                if closure.normal != Vec3::ZERO
+                if raise
                     && matches!(
                         (&l.top, &l.base),
                         (
@@ -256,7 +266,10 @@ impl ShadingPoint {
             }
             _ => None,
         };
-        let smooth = (closure.normal != Vec3::ZERO).then(|| {
+        let smooth = raise.then(|| {
+            if turned_away {
+                return n;
+            }
             let ns = if closure.surface_normal == Vec3::ZERO {
                 its.ns
             } else {
@@ -670,6 +683,29 @@ impl ShadingPoint {
             return None;
         }
         Some((wo, w, rec))
+    }
+}
+
+/// Whether `bsdf` shades an interpolated normal that turns away from the viewer as Cycles
+/// does (diffuse lobes light it as it is; the specular lobes that [`ShadingPoint::new`] raises
+/// above the surface reflect about the raised normal). Other lobes see it flipped towards
+/// the viewer.
+#[inline]
+fn keeps_turned_normal(bsdf: &BsdfInstance) -> bool {
+    match bsdf {
+        BsdfInstance::Diffuse(_)
+        | BsdfInstance::Mirror(_)
+        | BsdfInstance::RoughConductor(_)
+        | BsdfInstance::Dielectric(_)
+        | BsdfInstance::RoughDielectric(_) => true,
+        BsdfInstance::Layered(l) => matches!(
+            (&l.top, &l.base),
+            (
+                bsdf::layered::TopLobe::Specular(_),
+                bsdf::layered::BaseLobe::Diffuse(_)
+            )
+        ),
+        _ => false,
     }
 }
 

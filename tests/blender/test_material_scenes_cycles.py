@@ -803,13 +803,6 @@ GLASS_NORMAL_MAP_REASON = (
     "were raised above the surface 0.82x, p95 0.69)")
 
 
-# (id, builder, Cycles max_bounces, Cycles spp, Tesela spp)
-LOWPOLY_REASON = (
-    "Cycles raises interpolated normals of smooth low-poly specular objects (its bump map "
-    "correction applies wherever N differs from Ng); Tesela raises only mapped normals: block "
-    "p95 0.051. Raising interpolated normals too matched this scene (p95 0.015) but moved the "
-    "Cornell light passes' Glossy Direct off Cycles' (p95 0.037 -> 0.08), so it is not on yet")
-
 def light_path_emitter(output):
     """Emission 0.2 + the Light Path output ``output`` (a depth), as a Math Multiply Add."""
     mat, nt, out = node_material("LightPath" + output.replace(" ", ""))
@@ -868,7 +861,39 @@ def transparent_depth_stack():
     world(0.5)
 
 
+def rounded_cube(make_material, custom_from_vertices):
+    """A unit cube turned 0.6 rad, smooth, with normals bent outwards from its centre (the
+    low-poly "rounded box" look): custom normals set from its vertices, or a Normal Edit
+    modifier (Radial). Near its edges the normals turn away from the camera while the faces
+    face it: Cycles shades such normals as they are (diffuse lights them, the specular layer
+    reflects about them raised above the surface); flipping them towards the viewer left dark
+    wedges."""
+    scenes.clear_scene()
+    scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
+                    scenes.lambert("FloorMat", (0.8, 0.8, 0.8)))
+    scenes.add_sun_light("Sun", (-0.8, 0.3, -0.6), 3.0)
+    world(0.3)
+    scenes.add_camera((0.0, -4.0, 3.0), (0.0, 0.0, 0.4), fov=math.radians(40.0))
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(0.0, 0.0, 0.5))
+    ob = bpy.context.active_object
+    ob.data.materials.append(make_material())
+    ob.rotation_euler = (0.0, 0.0, 0.6)
+    me = ob.data
+    me.polygons.foreach_set("use_smooth", [True] * len(me.polygons))
+    if custom_from_vertices:
+        me.normals_split_custom_set_from_vertices([tuple(v.co.normalized()) for v in me.vertices])
+    else:
+        ob.modifiers.new("Round", "NORMAL_EDIT").mode = "RADIAL"
+    me.update()
+
+
+# (id, builder, Cycles max_bounces, Cycles spp, Tesela spp)
 CASES = [
+    ("rounded_cube_normal_edit_lambert",
+     lambda: rounded_cube(lambda: scenes.lambert("D", (0.2, 0.3, 0.8)), False), 0, 128, 512),
+    ("rounded_cube_custom_normals_principled",
+     lambda: rounded_cube(lambda: scenes.material("Blue", base_color=(0.2, 0.3, 0.8),
+                                                  roughness=0.3), True), 0, 128, 512),
     ("light_path_depths_in_mirror", light_path_depths_in_mirror, 2, 16, 64),
     ("light_path_depth_lighting", light_path_depth_lighting, 2, 256, 1024),
     ("transparent_depth_stack", transparent_depth_stack, 2, 64, 256),
@@ -893,8 +918,7 @@ CASES = [
     ("image_tube_projection", projected_image("TUBE", coords="Generated"), 0, 64, 256),
     ("mapping_scale_rotation", mapping_image, 0, 64, 256),
     ("mix_diffuse_glossy_layer_weight", mix_layer_weight, 0, 256, 1024),
-    pytest.param(("lowpoly_smooth_specular", lowpoly_smooth_specular, 2, 256, 1024),
-                 marks=pytest.mark.xfail(reason=LOWPOLY_REASON, strict=False)),
+    ("lowpoly_smooth_specular", lowpoly_smooth_specular, 2, 256, 1024),
     ("oren_nayar_diffuse_ball", oren_nayar_ball("diffuse"), 2, 128, 512),
     ("oren_nayar_principled_ball", oren_nayar_ball("principled"), 2, 128, 512),
     ("principled_black_base", black_base_ball, 2, 128, 512),
