@@ -511,6 +511,10 @@ class MaterialGraph:
         if out is not None and hasattr(out, "default_value"):
             props["direction"] = self._floats(out.default_value, node, "direction")
 
+    def _props_object_info(self, node, props):
+        # Object Info's Material Index is the material's Pass Index.
+        props["material_pass_index"] = int(getattr(self.material, "pass_index", 0) or 0)
+
     def _props_texcoord(self, node, props):
         ob = getattr(node, "object", None)
         if ob is not None:
@@ -593,6 +597,7 @@ _SPECIAL_PROPS = {
     "ShaderNodeTexImage": MaterialGraph._props_image,
     "ShaderNodeTexEnvironment": MaterialGraph._props_image,
     "ShaderNodeTexCoord": MaterialGraph._props_texcoord,
+    "ShaderNodeObjectInfo": MaterialGraph._props_object_info,
     "ShaderNodeValToRGB": MaterialGraph._props_ramp,
     "ShaderNodeRGBCurve": MaterialGraph._props_curves,
     "ShaderNodeVectorCurve": MaterialGraph._props_curves,

@@ -887,8 +887,27 @@ def rounded_cube(make_material, custom_from_vertices):
     me.update()
 
 
+def material_pass_index():
+    """Three quads whose materials (Pass Index 1, 2, 3) emit 0.4 x Object Info's Material
+    Index, seen from above: 0.4, 0.8 and 1.2."""
+    scenes.clear_scene()
+    for i in range(3):
+        mat, nt, out = node_material("Index%d" % i)
+        mat.pass_index = i + 1
+        oi = node(nt, "ShaderNodeObjectInfo")
+        m = node(nt, "ShaderNodeMath", {"operation": "MULTIPLY"}, Value=oi.outputs["Material Index"])
+        m.inputs[1].default_value = 0.4
+        surface(nt, out, node(nt, "ShaderNodeEmission", Color=m.outputs[0], Strength=1.0).outputs[0])
+        x = -1.5 + i
+        scenes.add_quad("Q%d" % i, [(x, -1.5, 0), (x + 1, -1.5, 0), (x + 1, 1.5, 0), (x, 1.5, 0)],
+                        mat)
+    scenes.add_camera((0, 0, 5), (0, 0, 0), ortho_scale=3.2)
+    world(0.0)
+
+
 # (id, builder, Cycles max_bounces, Cycles spp, Tesela spp)
 CASES = [
+    ("material_pass_index", material_pass_index, 0, 16, 64),
     ("rounded_cube_normal_edit_lambert",
      lambda: rounded_cube(lambda: scenes.lambert("D", (0.2, 0.3, 0.8)), False), 0, 128, 512),
     ("rounded_cube_custom_normals_principled",

@@ -277,8 +277,10 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             emit(cx, "Alpha", Float, Source::ObjectAlpha)?;
             emit(cx, "Object Index", Float, Source::ObjectIndex)?;
             emit(cx, "Random", Float, Source::ObjectRandom)?;
-            let zero = cx.constant(&[0.0])?;
-            cx.alias("Material Index", zero, Float);
+            // The material's Pass Index, which the exporter gives the node.
+            let index = cx.prop_f32("material_pass_index", 0.0);
+            let index = cx.constant(&[index])?;
+            cx.alias("Material Index", index, Float);
         }
         "ShaderNodeLightPath" => {
             for (id, bit) in [
