@@ -17,7 +17,8 @@ from .images import ImageTable, Textures
 from .instances import collapse
 from .light import convert_light
 from .material import DEFAULT_MATERIAL, MaterialReport, export_material
-from .mesh import MESHLIKE, geometry_key, mesh_arrays, object_extras, read_mesh
+from .mesh import (MESHLIKE, geometry_key, mesh_arrays, object_extras, read_mesh,
+                   undeformed_positions)
 from .world import convert_world
 
 
@@ -109,7 +110,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
         """The Geometry of an evaluated mesh: its data in this export's buffer, or, with a
         mesh store, in the store's file for its content (written unless a frame before wrote
         it)."""
-        raw = read_mesh(mesh, check_cancel, res.phases)
+        orco = undeformed_positions(obj, mesh, render=depsgraph.mode == "RENDER")
+        raw = read_mesh(mesh, check_cancel, res.phases, orco=orco)
         if raw is None:
             return None
         if mesh_store is None:

@@ -83,9 +83,53 @@ class RawMesh:
         return h.hexdigest()
 
 
-def read_mesh(mesh, check_cancel=None, phases=None):
+# The colour layer that carries a deformed mesh's undeformed positions (the renderer's
+# Generated coordinates read it; the Attribute node never sees it).
+ORCO_LAYER = "tesela:orco"
+
+# Modifiers that only move vertices (Blender's eModifierTypeType_OnlyDeform): Blender builds
+# the undeformed coordinates (CD_ORCO) without them.
+_DEFORM_ONLY = {"ARMATURE", "CAST", "CLOTH", "COLLISION", "CORRECTIVE_SMOOTH", "CURVE",
+                "DISPLACE", "HOOK", "LAPLACIANDEFORM", "LAPLACIANSMOOTH", "LATTICE",
+                "MESH_DEFORM", "SHRINKWRAP", "SIMPLE_DEFORM", "SMOOTH", "SOFT_BODY",
+                "SURFACE_DEFORM", "WARP", "WAVE", "MESH_CACHE"}
+# Modifiers that run on the undeformed mesh too but move no vertex.
+_POSITION_NEUTRAL = {"UV_PROJECT", "UV_WARP", "VERTEX_WEIGHT_EDIT", "VERTEX_WEIGHT_MIX",
+                     "VERTEX_WEIGHT_PROXIMITY", "DATA_TRANSFER", "NORMAL_EDIT", "WEIGHTED_NORMAL"}
+
+
+def undeformed_positions(obj, mesh, render=True):
+    """Object-space positions of the evaluated mesh's vertices before its deform modifiers and
+    shape keys (what Cycles' Generated coordinates use: Blender's CD_ORCO), for an object whose
+    modifiers only deform: the original mesh's (or its Texture Mesh's) vertices, when their
+    count is the evaluated `mesh`'s. None when they are its positions already, or
+    the stack also builds geometry (its undeformed mesh would have to be evaluated apart; the
+    deformed positions are used then)."""
+    orig = getattr(obj, "original", None) or obj
+    data = getattr(orig, "data", None)
+    if getattr(orig, "type", None) != "MESH" or data is None or not hasattr(data, "vertices"):
+        return None
+    enabled = [m for m in getattr(orig, "modifiers", ())
+               if (m.show_render if render else m.show_viewport)]
+    if not (any(m.type in _DEFORM_ONLY for m in enabled) or data.shape_keys is not None):
+        return None
+    if any(m.type not in _DEFORM_ONLY and m.type not in _POSITION_NEUTRAL for m in enabled):
+        return None
+    src = getattr(data, "texture_mesh", None) or data
+    n = len(mesh.vertices)
+    if len(src.vertices) != n or n == 0:
+        return None
+    co = compat.vertex_positions(mesh, n)
+    out = np.empty(n * 3, dtype=np.float32)
+    src.vertices.foreach_get("co", out)
+    out = out.reshape(-1, 3)
+    return None if np.array_equal(out, co) else out
+
+
+def read_mesh(mesh, check_cancel=None, phases=None, orco=None):
     """The RawMesh of an evaluated mesh, or None if it has no faces; phases: a Phases adding up
-    the seconds of each step."""
+    the seconds of each step; orco: its undeformed positions (undeformed_positions), carried
+    as the point colour layer ORCO_LAYER."""
     def checkpoint():
         if check_cancel is not None and check_cancel():
             raise ExportCancelled()
@@ -129,6 +173,9 @@ def read_mesh(mesh, check_cancel=None, phases=None):
             raw.colors = [(name, np.repeat(col, face_corners, axis=0), "CORNER")
                           if domain == "FACE" else (name, col, domain)
                           for name, col, domain in raw.colors]
+        if orco is not None and len(orco) == n_verts:
+            raw.colors.append((ORCO_LAYER, np.hstack([orco, np.ones((n_verts, 1), np.float32)]),
+                               "POINT"))
     checkpoint()
     raw.texspace = compat.texture_space(mesh)
     return raw

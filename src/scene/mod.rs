@@ -105,8 +105,16 @@ pub struct MeshAttributes {
     /// Texture space (Generated coordinates): `(location, size)` in object space; generated
     /// coordinates are `(p_object - location) / size · ½ + ½`.
     pub texspace: Option<(Vec3, Vec3)>,
+    /// Per-vertex object-space positions before the object's deform modifiers and shape keys
+    /// (Blender's undeformed coordinates, which Generated coordinates use); empty when they
+    /// are the positions themselves.
+    pub orco: Vec<Vec3>,
     pub object: ObjectInfo,
 }
+
+/// The vertex colour layer that carries [`MeshAttributes::orco`] in a file (the add-on
+/// writes it; it is not a colour the graph can read).
+pub const ORCO_LAYER: &str = "tesela:orco";
 
 impl Default for MeshAttributes {
     fn default() -> Self {
@@ -117,6 +125,7 @@ impl Default for MeshAttributes {
             tangents: Vec::new(),
             to_object: Mat4::IDENTITY,
             texspace: None,
+            orco: Vec::new(),
             object: ObjectInfo::default(),
         }
     }

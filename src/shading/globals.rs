@@ -303,11 +303,16 @@ impl<'a> ShaderGlobals<'a> {
         }
     }
 
-    /// Blender's Generated coordinates: the object-space position normalised to the texture
-    /// space (the mesh's bounds unless the add-on says otherwise).
+    /// Blender's Generated coordinates: the object-space position (before deform modifiers,
+    /// where the mesh carries that) normalised to the texture space (the mesh's bounds unless
+    /// the add-on says otherwise).
     pub fn generated(&self) -> Vec3 {
-        let po = self.object_position();
-        let Some(m) = self.mesh else { return po };
+        let Some(m) = self.mesh else {
+            return self.object_position();
+        };
+        let po = m
+            .interpolate(&m.attrs.orco, self.tri, self.b1, self.b2)
+            .unwrap_or_else(|| self.object_position());
         match m.attrs.texspace {
             Some((loc, size)) => {
                 let s = Vec3::select(size.cmpeq(Vec3::ZERO), Vec3::ONE, size);

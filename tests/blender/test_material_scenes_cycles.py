@@ -905,8 +905,43 @@ def material_pass_index():
     world(0.0)
 
 
+def deformed_checker_ball(kind):
+    """A smooth ball whose Diffuse colour is a Checker (scale 4) at its default Generated
+    coordinates, deformed by a Displace modifier (0.3 along X), a Simple Deform twist or a
+    shape key: Generated follows the undeformed shape, so the checks stay where they were on
+    the ball and stretch with it."""
+    def build():
+        scenes.clear_scene()
+        scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
+                        scenes.lambert("FloorMat", (0.8, 0.8, 0.8)))
+        scenes.add_sun_light("Sun", (-0.4, 0.3, -1.0), 3.0)
+        world(0.3)
+        scenes.add_camera((0.0, -4.0, 3.0), (0.0, 0.0, 0.5), fov=math.radians(40.0))
+        mat, nt, out = node_material("Checks")
+        ch = node(nt, "ShaderNodeTexChecker", Scale=4.0)
+        surface(nt, out, node(nt, "ShaderNodeBsdfDiffuse", Color=ch.outputs["Color"]).outputs[0])
+        ob = scenes.add_sphere("Ball", (0.0, 0.0, 0.7), 0.6, mat, segments=24, rings=12)
+        if kind == "displace":
+            m = ob.modifiers.new("D", "DISPLACE")
+            m.strength, m.direction = 0.3, "X"
+        elif kind == "twist":
+            m = ob.modifiers.new("D", "SIMPLE_DEFORM")
+            m.deform_method, m.angle = "TWIST", 1.2
+        else:
+            ob.shape_key_add(name="Basis")
+            key = ob.shape_key_add(name="Squash")
+            for v in key.data:
+                v.co.z *= 0.6
+                v.co.x *= 1.3
+            key.value = 1.0
+    return build
+
+
 # (id, builder, Cycles max_bounces, Cycles spp, Tesela spp)
 CASES = [
+    ("generated_under_displace", deformed_checker_ball("displace"), 0, 128, 512),
+    ("generated_under_twist", deformed_checker_ball("twist"), 0, 128, 512),
+    ("generated_under_shape_key", deformed_checker_ball("shape_key"), 0, 128, 512),
     ("material_pass_index", material_pass_index, 0, 16, 64),
     ("rounded_cube_normal_edit_lambert",
      lambda: rounded_cube(lambda: scenes.lambert("D", (0.2, 0.3, 0.8)), False), 0, 128, 512),

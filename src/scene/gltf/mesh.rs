@@ -350,13 +350,22 @@ impl<'a> Loader<'a> {
             } else {
                 format!("{base_name}.{pi}")
             };
+            let mut colors = local.colors.clone();
+            let orco = match colors
+                .iter()
+                .position(|(n, _)| n == crate::scene::ORCO_LAYER)
+            {
+                Some(i) => colors.remove(i).1.iter().map(|c| c.truncate()).collect(),
+                None => Vec::new(),
+            };
             let attrs = MeshAttributes {
                 uv_names: local.uv_names.clone(),
                 extra_uvs: local.extra_uvs.clone(),
-                colors: local.colors.clone(),
+                colors,
                 tangents: super::tangents::to_world(&local.tangents, world),
                 to_object,
                 texspace,
+                orco,
                 object: object.clone(),
             };
             self.scene.meshes.push(Mesh {
