@@ -937,8 +937,30 @@ def deformed_checker_ball(kind):
     return build
 
 
+def checker_from_empty():
+    """A ball whose Diffuse colour is a Checker over Texture Coordinate > Object with an Empty
+    set (moved, turned and scaled unevenly): the checks sit in the Empty's space."""
+    scenes.clear_scene()
+    scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
+                    scenes.lambert("FloorMat", (0.8, 0.8, 0.8)))
+    scenes.add_sun_light("Sun", (-0.4, 0.3, -1.0), 3.0)
+    world(0.3)
+    scenes.add_camera((0.0, -4.0, 3.0), (0.0, 0.0, 0.5), fov=math.radians(40.0))
+    empty = bpy.data.objects.new("Placer", None)
+    bpy.context.scene.collection.objects.link(empty)
+    empty.location = (0.3, -0.2, 0.5)
+    empty.rotation_euler = (0.4, 0.2, 0.9)
+    empty.scale = (0.5, 1.0, 2.0)
+    mat, nt, out = node_material("Placed")
+    tc = node(nt, "ShaderNodeTexCoord", {"object": empty})
+    ch = node(nt, "ShaderNodeTexChecker", Scale=2.0, Vector=tc.outputs["Object"])
+    surface(nt, out, node(nt, "ShaderNodeBsdfDiffuse", Color=ch.outputs["Color"]).outputs[0])
+    scenes.add_sphere("Ball", (0.0, 0.0, 0.7), 0.6, mat, segments=32, rings=16)
+
+
 # (id, builder, Cycles max_bounces, Cycles spp, Tesela spp)
 CASES = [
+    ("texture_coordinates_of_an_empty", checker_from_empty, 0, 128, 512),
     ("generated_under_displace", deformed_checker_ball("displace"), 0, 128, 512),
     ("generated_under_twist", deformed_checker_ball("twist"), 0, 128, 512),
     ("generated_under_shape_key", deformed_checker_ball("shape_key"), 0, 128, 512),

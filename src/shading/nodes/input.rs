@@ -17,6 +17,9 @@ pub enum Source {
     /// UV set `n` in glTF's convention (the glTF preset graph's texture coordinates).
     GltfUv(usize),
     Object,
+    /// The position in the space of another object: its world → object matrix (Blender's
+    /// world), as Texture Coordinate's Object output with an object set.
+    ObjectOf(Box<glam::Mat4>),
     Camera,
     Reflection,
     Position,
@@ -128,6 +131,7 @@ impl InputOp {
                 s.set_v(self.out, uv.extend(0.0));
             }
             Source::Object => s.set_v(self.out, g.object_position()),
+            Source::ObjectOf(m) => s.set_v(self.out, m.transform_point3(g.p)),
             Source::Camera => s.set_v(self.out, camera_position(&env.camera_to_world, g.p)),
             Source::Reflection => s.set_v(self.out, 2.0 * g.n.dot(g.i) * g.n - g.i),
             Source::Position => s.set_v(self.out, g.p),
@@ -217,20 +221,45 @@ fn emit(cx: &mut NodeCx, id: &str, ty: SocketType, src: Source) -> Result<(), Co
     Ok(())
 }
 
+/// The world → object matrix of an object whose `matrix_world` is `rows` (4 rows of 4, Blender
+/// world), if it is one and invertible.
+fn object_matrix(rows: &serde_json::Value) -> Option<glam::Mat4> {
+    let rows = rows.as_array().filter(|r| r.len() == 4)?;
+    let mut m = [[0.0f32; 4]; 4];
+    for (i, row) in rows.iter().enumerate() {
+        let row = row.as_array().filter(|r| r.len() == 4)?;
+        for (j, v) in row.iter().enumerate() {
+            // Column j, row i.
+            m[j][i] = v.as_f64()? as f32;
+        }
+    }
+    let m = glam::Mat4::from_cols_array_2d(&m);
+    let det = m.determinant();
+    (det.is_finite() && det.abs() > 1e-30).then(|| m.inverse())
+}
+
 /// Compiles input nodes; `Ok(false)` for other kinds.
 pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
     use SocketType::{Color, Float, Vector};
     match kind {
         "ShaderNodeTexCoord" => {
-            if cx.prop("object").is_some_and(|o| !o.is_null()) {
-                cx.warn(
-                    "texture coordinates from another object are not supported; its own are used",
-                );
-            }
+            let other = match cx.prop("object") {
+                None | Some(serde_json::Value::Null) => None,
+                Some(v) => {
+                    let m = object_matrix(v);
+                    if m.is_none() {
+                        cx.warn("its object's matrix cannot be inverted (or is not a 4x4 matrix); the material's own object coordinates are used");
+                    }
+                    m
+                }
+            };
             emit(cx, "Generated", Vector, Source::Generated)?;
             emit(cx, "Normal", Vector, Source::ObjectNormal)?;
             emit(cx, "UV", Vector, Source::Uv(String::new()))?;
-            emit(cx, "Object", Vector, Source::Object)?;
+            match other {
+                Some(m) => emit(cx, "Object", Vector, Source::ObjectOf(Box::new(m)))?,
+                None => emit(cx, "Object", Vector, Source::Object)?,
+            }
             emit(cx, "Camera", Vector, Source::Camera)?;
             emit(cx, "Reflection", Vector, Source::Reflection)?;
             // Window coordinates need the projection: reported when used.
