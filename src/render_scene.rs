@@ -30,6 +30,9 @@ pub struct Intersection {
     pub p: Vec3,
     /// Unit geometric normal, flipped if needed to lie on the same side as `ns`.
     pub ng: Vec3,
+    /// Whether `ng` was flipped so (it then points against the triangle's winding: the
+    /// face's front is `-ng`).
+    pub ng_flipped: bool,
     /// Unit shading normal (interpolated vertex normals, or `ng`).
     pub ns: Vec3,
     pub uv: Vec2,
@@ -46,6 +49,12 @@ pub struct Intersection {
 }
 
 impl Intersection {
+    /// The face's front normal (unit, along the triangle's winding).
+    #[inline]
+    pub fn face_normal(&self) -> Vec3 {
+        if self.ng_flipped { -self.ng } else { self.ng }
+    }
+
     /// Shading frame around `ns`.
     pub fn frame(&self) -> Frame {
         Frame::from_normal(self.ns)
@@ -1262,7 +1271,8 @@ impl RenderScene {
                 .unwrap_or(ng);
             (ns, inst.material.unwrap_or(mesh.material))
         };
-        if ng.dot(ns) < 0.0 {
+        let ng_flipped = ng.dot(ns) < 0.0;
+        if ng_flipped {
             ng = -ng;
         }
         let uv = mesh
@@ -1272,6 +1282,7 @@ impl RenderScene {
             t: hit.t,
             p: hit.p,
             ng,
+            ng_flipped,
             ns,
             uv,
             mesh: mi,

@@ -193,11 +193,12 @@ impl ShadingPoint {
                 n = -n;
             }
         } else if closure.normal == Vec3::ZERO
-            && (its.ng.dot(-d) < 0.0 || (n.dot(-d) < 0.0 && !keeps_turned_normal(&bsdf)))
+            && n.dot(-d) < 0.0
+            && (its.face_normal().dot(-d) < 0.0 || !keeps_turned_normal(&bsdf))
         {
-            // The interpolated normal flipped with the face (`its.ng` lies on its side), as
-            // Cycles' N; like a closure's own normal, it stays as it is where it turns away
-            // from the viewer on a face seen from the front (a diffuse lobe still lights it),
+            // The interpolated normal turned away from the viewer is flipped with the face
+            // when the face is seen from behind, as Cycles' N; like a closure's own normal it
+            // stays as it is on a face seen from the front (a diffuse lobe still lights it),
             // for the lobes that shade such a normal as Cycles does.
             n = -n;
         }

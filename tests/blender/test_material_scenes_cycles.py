@@ -958,8 +958,31 @@ def checker_from_empty():
     scenes.add_sphere("Ball", (0.0, 0.0, 0.7), 0.6, mat, segments=32, rings=16)
 
 
+def normals_up_ball():
+    """A low-poly smooth ball (10 x 6) whose custom normals all point up (the soft look of
+    foliage), Principled at roughness 0.3, under a low sun: on its lower half the normals
+    point against the faces' winding; a face is seen from the front by its winding, not by
+    the normal. Cycles' shadow terminator offset is off (Tesela has none)."""
+    scenes.clear_scene()
+    scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
+                    scenes.lambert("FloorMat", (0.8, 0.8, 0.8)))
+    scenes.add_sun_light("Sun", (-0.8, 0.3, -0.6), 3.0)
+    world(0.3)
+    scenes.add_camera((0.0, -4.0, 3.0), (0.0, 0.0, 0.4), fov=math.radians(40.0))
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=10, ring_count=6, radius=0.6,
+                                         location=(0.0, 0.0, 0.6))
+    ob = bpy.context.active_object
+    ob.data.materials.append(scenes.material("Ball", base_color=(0.8, 0.8, 0.8), roughness=0.3))
+    ob.shadow_terminator_geometry_offset = 0.0
+    me = ob.data
+    me.polygons.foreach_set("use_smooth", [True] * len(me.polygons))
+    me.normals_split_custom_set([(0.0, 0.0, 1.0)] * len(me.loops))
+    me.update()
+
+
 # (id, builder, Cycles max_bounces, Cycles spp, Tesela spp)
 CASES = [
+    ("custom_normals_all_up", normals_up_ball, 0, 128, 512),
     ("texture_coordinates_of_an_empty", checker_from_empty, 0, 128, 512),
     ("generated_under_displace", deformed_checker_ball("displace"), 0, 128, 512),
     ("generated_under_twist", deformed_checker_ball("twist"), 0, 128, 512),
