@@ -65,6 +65,23 @@ def scatter():
     return info
 
 
+def assert_agrees_with_cycles(scene, label, spp, tmp_path):
+    """Cycles and Tesela (through the add-on, direct lighting with MIS) render `scene` at
+    `spp`; the images must agree (means within 2%, 8x8-block p95 within 5%)."""
+    scenes.configure_cycles(scene, SIZE, SIZE, spp, 0, seed=7)
+    ref = imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
+    scene.render.engine = "TESELA"
+    t = scene.tesela
+    scenes.tesela_like_cycles(t)
+    t.integrator, t.samples, t.max_depth, t.seed = "direct_mis", spp, 2, 1
+    t.threads = int(os.environ.get("TESELA_TEST_THREADS", "0"))
+    assert bpy.ops.render.render() == {"FINISHED"}
+    got = result_pixels(tmp_path)
+    result = imgcompare.compare(got, ref, mean_tol=0.02, block_tol=0.05)
+    print(f"{label}: {result}")
+    assert result.ok, f"{label}: Tesela (add-on) vs Cycles: {result}"
+
+
 def test_scatter_exports_one_mesh_and_its_instances(addon, tmp_path):
     scatter()
     depsgraph = bpy.context.evaluated_depsgraph_get()
@@ -88,21 +105,7 @@ def test_scatter_exports_one_mesh_and_its_instances(addon, tmp_path):
 
 def test_scatter_agrees_with_cycles(addon, tesela_bin, tmp_path, monkeypatch):
     monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
-    info = scatter()
-    scene = info.scene
-    spp = 256
-    scenes.configure_cycles(scene, SIZE, SIZE, spp, 0, seed=7)
-    ref = imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
-    scene.render.engine = "TESELA"
-    t = scene.tesela
-    scenes.tesela_like_cycles(t)
-    t.integrator, t.samples, t.max_depth, t.seed = "direct_mis", spp, 2, 1
-    t.threads = int(os.environ.get("TESELA_TEST_THREADS", "0"))
-    assert bpy.ops.render.render() == {"FINISHED"}
-    got = result_pixels(tmp_path)
-    result = imgcompare.compare(got, ref, mean_tol=0.02, block_tol=0.05)
-    print(f"scatter: {result}")
-    assert result.ok, f"scatter: Tesela (add-on) vs Cycles: {result}"
+    assert_agrees_with_cycles(scatter().scene, "scatter", 256, tmp_path)
 
 
 def test_collection_instances_share_one_mesh(addon, tmp_path):
@@ -174,20 +177,7 @@ def test_hidden_particle_emitter_agrees_with_cycles(addon, tesela_bin, tmp_path,
     """Show Emitter off: Cycles renders the particles, not the emitting mesh (the depsgraph's
     show_self); rendering the host plane too puts a red square over the floor."""
     monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
-    scene = particle_host_hidden()
-    spp = 128
-    scenes.configure_cycles(scene, SIZE, SIZE, spp, 0, seed=7)
-    ref = imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
-    scene.render.engine = "TESELA"
-    t = scene.tesela
-    scenes.tesela_like_cycles(t)
-    t.integrator, t.samples, t.max_depth, t.seed = "direct_mis", spp, 2, 1
-    t.threads = int(os.environ.get("TESELA_TEST_THREADS", "0"))
-    assert bpy.ops.render.render() == {"FINISHED"}
-    got = result_pixels(tmp_path)
-    result = imgcompare.compare(got, ref, mean_tol=0.02, block_tol=0.05)
-    print(f"hidden particle emitter: {result}")
-    assert result.ok, f"hidden particle emitter: Tesela (add-on) vs Cycles: {result}"
+    assert_agrees_with_cycles(particle_host_hidden(), "hidden particle emitter", 128, tmp_path)
 
 
 def curve_text_meta_surface():
@@ -252,17 +242,4 @@ def gn_pipe():
 
 def test_geometry_nodes_pipe_agrees_with_cycles(addon, tesela_bin, tmp_path, monkeypatch):
     monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
-    scene = gn_pipe().scene
-    spp = 128
-    scenes.configure_cycles(scene, SIZE, SIZE, spp, 0, seed=7)
-    ref = imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
-    scene.render.engine = "TESELA"
-    t = scene.tesela
-    scenes.tesela_like_cycles(t)
-    t.integrator, t.samples, t.max_depth, t.seed = "direct_mis", spp, 2, 1
-    t.threads = int(os.environ.get("TESELA_TEST_THREADS", "0"))
-    assert bpy.ops.render.render() == {"FINISHED"}
-    got = result_pixels(tmp_path)
-    result = imgcompare.compare(got, ref, mean_tol=0.02, block_tol=0.05)
-    print(f"geometry nodes pipe: {result}")
-    assert result.ok, f"geometry nodes pipe: Tesela (add-on) vs Cycles: {result}"
+    assert_agrees_with_cycles(gn_pipe().scene, "geometry nodes pipe", 128, tmp_path)

@@ -861,6 +861,17 @@ def transparent_depth_stack():
     world(0.5)
 
 
+def lit_floor(sun_direction, camera_target):
+    """A cleared scene with a 6 m grey floor under a sun of strength 3 along `sun_direction`,
+    a dim world (0.3) and a camera at (0, -4, 3) looking at `camera_target` (40 degrees)."""
+    scenes.clear_scene()
+    scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
+                    scenes.lambert("FloorMat", (0.8, 0.8, 0.8)))
+    scenes.add_sun_light("Sun", sun_direction, 3.0)
+    world(0.3)
+    scenes.add_camera((0.0, -4.0, 3.0), camera_target, fov=math.radians(40.0))
+
+
 def rounded_cube(make_material, custom_from_vertices):
     """A unit cube turned 0.6 rad, smooth, with normals bent outwards from its centre (the
     low-poly "rounded box" look): custom normals set from its vertices, or a Normal Edit
@@ -868,12 +879,7 @@ def rounded_cube(make_material, custom_from_vertices):
     face it: Cycles shades such normals as they are (diffuse lights them, the specular layer
     reflects about them raised above the surface); flipping them towards the viewer left dark
     wedges."""
-    scenes.clear_scene()
-    scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
-                    scenes.lambert("FloorMat", (0.8, 0.8, 0.8)))
-    scenes.add_sun_light("Sun", (-0.8, 0.3, -0.6), 3.0)
-    world(0.3)
-    scenes.add_camera((0.0, -4.0, 3.0), (0.0, 0.0, 0.4), fov=math.radians(40.0))
+    lit_floor((-0.8, 0.3, -0.6), (0.0, 0.0, 0.4))
     bpy.ops.mesh.primitive_cube_add(size=1.0, location=(0.0, 0.0, 0.5))
     ob = bpy.context.active_object
     ob.data.materials.append(make_material())
@@ -911,12 +917,7 @@ def deformed_checker_ball(kind):
     shape key: Generated follows the undeformed shape, so the checks stay where they were on
     the ball and stretch with it."""
     def build():
-        scenes.clear_scene()
-        scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
-                        scenes.lambert("FloorMat", (0.8, 0.8, 0.8)))
-        scenes.add_sun_light("Sun", (-0.4, 0.3, -1.0), 3.0)
-        world(0.3)
-        scenes.add_camera((0.0, -4.0, 3.0), (0.0, 0.0, 0.5), fov=math.radians(40.0))
+        lit_floor((-0.4, 0.3, -1.0), (0.0, 0.0, 0.5))
         mat, nt, out = node_material("Checks")
         ch = node(nt, "ShaderNodeTexChecker", Scale=4.0)
         surface(nt, out, node(nt, "ShaderNodeBsdfDiffuse", Color=ch.outputs["Color"]).outputs[0])
@@ -940,12 +941,7 @@ def deformed_checker_ball(kind):
 def checker_from_empty():
     """A ball whose Diffuse colour is a Checker over Texture Coordinate > Object with an Empty
     set (moved, turned and scaled unevenly): the checks sit in the Empty's space."""
-    scenes.clear_scene()
-    scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
-                    scenes.lambert("FloorMat", (0.8, 0.8, 0.8)))
-    scenes.add_sun_light("Sun", (-0.4, 0.3, -1.0), 3.0)
-    world(0.3)
-    scenes.add_camera((0.0, -4.0, 3.0), (0.0, 0.0, 0.5), fov=math.radians(40.0))
+    lit_floor((-0.4, 0.3, -1.0), (0.0, 0.0, 0.5))
     empty = bpy.data.objects.new("Placer", None)
     bpy.context.scene.collection.objects.link(empty)
     empty.location = (0.3, -0.2, 0.5)
@@ -963,12 +959,7 @@ def normals_up_ball():
     foliage), Principled at roughness 0.3, under a low sun: on its lower half the normals
     point against the faces' winding; a face is seen from the front by its winding, not by
     the normal. Cycles' shadow terminator offset is off (Tesela has none)."""
-    scenes.clear_scene()
-    scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
-                    scenes.lambert("FloorMat", (0.8, 0.8, 0.8)))
-    scenes.add_sun_light("Sun", (-0.8, 0.3, -0.6), 3.0)
-    world(0.3)
-    scenes.add_camera((0.0, -4.0, 3.0), (0.0, 0.0, 0.4), fov=math.radians(40.0))
+    lit_floor((-0.8, 0.3, -0.6), (0.0, 0.0, 0.4))
     bpy.ops.mesh.primitive_uv_sphere_add(segments=10, ring_count=6, radius=0.6,
                                          location=(0.0, 0.0, 0.6))
     ob = bpy.context.active_object
