@@ -209,26 +209,19 @@ impl ShadingPoint {
         let turned_away =
             !bsdf.is_transmissive() && closure.normal == Vec3::ZERO && n.dot(-d) < 0.0;
         let raise = closure.normal != Vec3::ZERO || turned_away;
-        if raise
-            && matches!(
-                bsdf,
-                BsdfInstance::Mirror(_)
-                    | BsdfInstance::RoughConductor(_)
-                    | BsdfInstance::Dielectric(_)
-                    | BsdfInstance::RoughDielectric(_)
-            )
-        {
+        // The geometric normal on the viewer's side, what raised normals stay above.
+        let ng_seen = if its.ng.dot(-d) < 0.0 {
+            -its.ng
+        } else {
+            its.ng
+        };
+        if raise && raises_specular_normal(&bsdf) {
             // Specular lobes (Glossy, Glass, Refraction, metallic or transmissive Principled)
             // under a normal or bump map reflect above the geometric surface, as Cycles makes
             // them; a transmissive lobe's normal is raised on the viewer's side.
-            let ng = if its.ng.dot(-d) < 0.0 {
-                -its.ng
-            } else {
-                its.ng
-            };
             // (A transmissive lobe's normal points outwards; a reflective one's is Cycles' N.)
             let flip = bsdf.is_transmissive() && n.dot(-d) < 0.0;
-            let m = bsdf::closure::valid_specular_normal(ng, -d, if flip { -n } else { n });
+            let m = bsdf::closure::valid_specular_normal(ng_seen, -d, if flip { -n } else { n });
             n = if flip { -m } else { m };
         }
         let rotation = anisotropic_rotation(&closure.kind);
@@ -246,27 +239,12 @@ impl ShadingPoint {
             None => Frame::from_normal(n),
         };
         let frame = frame_of(n);
-        let glossy_frame = match &bsdf {
-            BsdfInstance::Layered(l)
-                if raise
-                    && matches!(
-                        (&l.top, &l.base),
-                        (
-                            bsdf::layered::TopLobe::Specular(_),
-                            bsdf::layered::BaseLobe::Diffuse(_)
-                        )
-                    ) =>
-            {
-                let ng = if its.ng.dot(-d) < 0.0 {
-                    -its.ng
-                } else {
-                    its.ng
-                };
-                let m = bsdf::closure::valid_specular_normal(ng, -d, n);
+        let glossy_frame = (raise && specular_over_diffuse(&bsdf))
+            .then(|| {
+                let m = bsdf::closure::valid_specular_normal(ng_seen, -d, n);
                 (m != n).then(|| frame_of(m))
-            }
-            _ => None,
-        };
+            })
+            .flatten();
         let smooth = raise.then(|| {
             if turned_away {
                 return n;
@@ -693,21 +671,34 @@ impl ShadingPoint {
 /// the viewer.
 #[inline]
 fn keeps_turned_normal(bsdf: &BsdfInstance) -> bool {
-    match bsdf {
-        BsdfInstance::Diffuse(_)
-        | BsdfInstance::Mirror(_)
-        | BsdfInstance::RoughConductor(_)
-        | BsdfInstance::Dielectric(_)
-        | BsdfInstance::RoughDielectric(_) => true,
-        BsdfInstance::Layered(l) => matches!(
+    matches!(bsdf, BsdfInstance::Diffuse(_))
+        || raises_specular_normal(bsdf)
+        || specular_over_diffuse(bsdf)
+}
+
+/// The specular lobes whose normal [`ShadingPoint::new`] raises above the geometric surface
+/// (Glossy, Glass, Refraction, metallic or transmissive Principled).
+#[inline]
+fn raises_specular_normal(bsdf: &BsdfInstance) -> bool {
+    matches!(
+        bsdf,
+        BsdfInstance::Mirror(_)
+            | BsdfInstance::RoughConductor(_)
+            | BsdfInstance::Dielectric(_)
+            | BsdfInstance::RoughDielectric(_)
+    )
+}
+
+/// Principled's dielectric: a specular layer over diffuse, shaded in two frames.
+#[inline]
+fn specular_over_diffuse(bsdf: &BsdfInstance) -> bool {
+    matches!(
+        bsdf,
+        BsdfInstance::Layered(l) if matches!(
             (&l.top, &l.base),
-            (
-                bsdf::layered::TopLobe::Specular(_),
-                bsdf::layered::BaseLobe::Diffuse(_)
-            )
-        ),
-        _ => false,
-    }
+            (bsdf::layered::TopLobe::Specular(_), bsdf::layered::BaseLobe::Diffuse(_))
+        )
+    )
 }
 
 /// The rotation (in turns) of an anisotropic closure's tangent, `None` for isotropic ones.
