@@ -110,10 +110,10 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
         """The Geometry of an evaluated mesh: its data in this export's buffer, or, with a
         mesh store, in the store's file for its content (written unless a frame before wrote
         it)."""
-        orco = undeformed_positions(obj, mesh, render=depsgraph.mode == "RENDER")
-        raw = read_mesh(mesh, check_cancel, res.phases, orco=orco)
+        raw = read_mesh(mesh, check_cancel, res.phases)
         if raw is None:
             return None
+        raw.add_orco(undeformed_positions(obj, raw.co, render=depsgraph.mode == "RENDER"))
         if mesh_store is None:
             return build_geometry(buf, obj, mesh, raw, n_slots, tangent_uvs, texture_without_uv,
                                   warnings.append)

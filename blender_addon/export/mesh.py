@@ -69,6 +69,13 @@ class RawMesh:
         self.colors = []         # [(name, float32 (n_loops or n_verts, 4), domain)]
         self.texspace = None     # (location, size)
 
+    def add_orco(self, orco):
+        """Carries undeformed positions (undeformed_positions; None: none) as the point colour
+        layer ORCO_LAYER."""
+        if orco is not None and len(orco) == len(self.co):
+            ones = np.ones((len(orco), 1), np.float32)
+            self.colors.append((ORCO_LAYER, np.hstack([orco, ones]), "POINT"))
+
     def digest(self, *context):
         """blake2b of every array and of `context` (what else the export depends on, e.g. the
         UV maps the materials want tangents for), hex."""
@@ -98,11 +105,11 @@ _POSITION_NEUTRAL = {"UV_PROJECT", "UV_WARP", "VERTEX_WEIGHT_EDIT", "VERTEX_WEIG
                      "VERTEX_WEIGHT_PROXIMITY", "DATA_TRANSFER", "NORMAL_EDIT", "WEIGHTED_NORMAL"}
 
 
-def undeformed_positions(obj, mesh, render=True):
+def undeformed_positions(obj, co, render=True):
     """Object-space positions of the evaluated mesh's vertices before its deform modifiers and
     shape keys (what Cycles' Generated coordinates use: Blender's CD_ORCO), for an object whose
     modifiers only deform: the original mesh's (or its Texture Mesh's) vertices, when their
-    count is the evaluated `mesh`'s. None when they are its positions already, or
+    count is that of the evaluated positions `co`. None when they are `co` already, or
     the stack also builds geometry (its undeformed mesh would have to be evaluated apart; the
     deformed positions are used then)."""
     orig = getattr(obj, "original", None) or obj
@@ -116,20 +123,18 @@ def undeformed_positions(obj, mesh, render=True):
     if any(m.type not in _DEFORM_ONLY and m.type not in _POSITION_NEUTRAL for m in enabled):
         return None
     src = getattr(data, "texture_mesh", None) or data
-    n = len(mesh.vertices)
+    n = len(co)
     if len(src.vertices) != n or n == 0:
         return None
-    co = compat.vertex_positions(mesh, n)
     out = np.empty(n * 3, dtype=np.float32)
     src.vertices.foreach_get("co", out)
     out = out.reshape(-1, 3)
     return None if np.array_equal(out, co) else out
 
 
-def read_mesh(mesh, check_cancel=None, phases=None, orco=None):
+def read_mesh(mesh, check_cancel=None, phases=None):
     """The RawMesh of an evaluated mesh, or None if it has no faces; phases: a Phases adding up
-    the seconds of each step; orco: its undeformed positions (undeformed_positions), carried
-    as the point colour layer ORCO_LAYER."""
+    the seconds of each step."""
     def checkpoint():
         if check_cancel is not None and check_cancel():
             raise ExportCancelled()
@@ -173,9 +178,6 @@ def read_mesh(mesh, check_cancel=None, phases=None, orco=None):
             raw.colors = [(name, np.repeat(col, face_corners, axis=0), "CORNER")
                           if domain == "FACE" else (name, col, domain)
                           for name, col, domain in raw.colors]
-        if orco is not None and len(orco) == n_verts:
-            raw.colors.append((ORCO_LAYER, np.hstack([orco, np.ones((n_verts, 1), np.float32)]),
-                               "POINT"))
     checkpoint()
     raw.texspace = compat.texture_space(mesh)
     return raw
