@@ -321,7 +321,13 @@ pub struct RenderScene {
     light_bvh: LightBvh,
     /// Distant lights of non-zero angle, which rays leaving the scene can meet.
     suns: Vec<u32>,
+    /// The light choice of emitter sampling on its own (`direct_ems`).
     pub lights: LightSampler,
+    /// The light choice of emitter sampling combined with BSDF sampling by MIS, when it
+    /// differs from `lights`: a constant world is left to BSDF sampling, as Cycles does (a
+    /// uniform world is found well by the BSDF's samples, and choosing it as a light would
+    /// take shadow rays from the other lights). `None`: the same as `lights`.
+    mis_lights: Option<LightSampler>,
     /// Radius of the scene's bounding sphere.
     pub radius: f32,
     /// Number of triangles.
@@ -414,6 +420,7 @@ struct LightParts {
     light_bvh: LightBvh,
     suns: Vec<u32>,
     lights: LightSampler,
+    mis_lights: Option<LightSampler>,
 }
 
 impl LightParts {
@@ -521,6 +528,14 @@ impl LightParts {
         let powers: Vec<f32> = emitters.iter().map(|e| e.power(scene, radius)).collect();
         let bounds: Vec<_> = emitters.iter().map(|e| light_bounds(scene, e)).collect();
         let lights = LightSampler::with_bounds(&powers, &bounds, choice);
+        let constant_world = background
+            .filter(|&b| matches!(emitters[b as usize], EmitterInstance::Background(_)))
+            .filter(|&b| powers[b as usize] > 0.0);
+        let mis_lights = constant_world.map(|b| {
+            let mut powers = powers.clone();
+            powers[b as usize] = 0.0;
+            LightSampler::with_bounds(&powers, &bounds, choice)
+        });
         LightParts {
             emitter_accel,
             emitters,
@@ -531,6 +546,7 @@ impl LightParts {
             light_bvh,
             suns,
             lights,
+            mis_lights,
         }
     }
 }
@@ -587,6 +603,7 @@ impl RenderScene {
             light_bvh: parts.light_bvh,
             suns: parts.suns,
             lights: parts.lights,
+            mis_lights: parts.mis_lights,
             radius,
             choice,
         };
@@ -635,6 +652,7 @@ impl RenderScene {
         self.light_bvh = p.light_bvh;
         self.suns = p.suns;
         self.lights = p.lights;
+        self.mis_lights = p.mis_lights;
     }
 
     /// Whether [`RenderScene::refresh_shading`] can take the scene's materials as they stand
@@ -1576,24 +1594,35 @@ impl RenderScene {
     /// density of emitter sampling producing this direction, for MIS.
     #[inline]
     pub fn light_pdf(&self, emitter: u32, rec: &EmitterQueryRecord) -> f32 {
-        self.lights.pmf_at(rec.ref_p, emitter as usize)
+        self.light_choice(true).pmf_at(rec.ref_p, emitter as usize)
             * self.emitters[emitter as usize].pdf(&self.scene, rec)
     }
 
+    /// The light choice of emitter sampling combined with BSDF sampling by MIS (`mis`), or on
+    /// its own.
+    #[inline]
+    pub fn light_choice(&self, mis: bool) -> &LightSampler {
+        match &self.mis_lights {
+            Some(l) if mis => l,
+            _ => &self.lights,
+        }
+    }
+
     /// Chooses an emitter and samples it from `ref_p`, the path being at the vertex and
-    /// bounces `path` its emitter's shader sees ([`Ctx::light_sample_at`]). Returns the record
-    /// and the weight `Le / (pmf · pdf)` (zero when no light could be sampled).
+    /// bounces `path` its emitter's shader sees ([`Ctx::light_sample_at`]); `mis`: the sample
+    /// is combined with BSDF sampling by MIS ([`Self::light_choice`]). Returns the record and
+    /// the weight `Le / (pmf · pdf)` (zero when no light could be sampled).
     #[inline]
     pub fn sample_light(
         &self,
         ref_p: Vec3,
-        u_choice: f32,
-        u: Vec2,
+        (u_choice, u): (f32, Vec2),
         (depth, depths): PathAt,
+        mis: bool,
     ) -> (u32, EmitterQueryRecord, Vec3) {
         let mut rec = EmitterQueryRecord::from_ref(ref_p);
         (rec.depth, rec.depths) = (depth, depths);
-        let Some((i, pmf)) = self.lights.sample_at(ref_p, u_choice) else {
+        let Some((i, pmf)) = self.light_choice(mis).sample_at(ref_p, u_choice) else {
             return (0, rec, Vec3::ZERO);
         };
         let w = self.emitters[i].sample(&self.scene, &mut rec, u);

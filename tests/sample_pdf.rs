@@ -695,36 +695,76 @@ fn kind(e: &EmitterInstance) -> &'static str {
 fn light_choice_is_folded_into_the_reported_pdf() {
     for choice in [LightChoice::Power, LightChoice::Uniform] {
         let rs = RenderScene::new(emitter_scene(), choice);
-        let mut rng = Sampler::new(400, 0, 0);
-        for _ in 0..20_000 {
-            let ref_p = v(4.0, 2.0, 4.0) * (rng.next_2d().extend(rng.next_1d()) - 0.5);
-            let (i, rec, w) =
-                rs.sample_light(ref_p, rng.next_1d(), rng.next_2d(), (2, Default::default()));
-            let e = &rs.emitters[i as usize];
-            let pmf = rs.lights.pmf(i as usize);
-            assert!(pmf > 0.0);
-            if rs.is_delta_light(i) {
-                assert_eq!(rec.pdf, 0.0);
-                assert_eq!(rs.light_pdf(i, &rec), 0.0);
-                continue;
+        // Emitter sampling on its own, and combined with BSDF sampling by MIS (whose density
+        // `light_pdf` reports).
+        for mis in [false, true] {
+            let lights = rs.light_choice(mis);
+            let mut rng = Sampler::new(400, 0, 0);
+            for _ in 0..20_000 {
+                let ref_p = v(4.0, 2.0, 4.0) * (rng.next_2d().extend(rng.next_1d()) - 0.5);
+                let u = (rng.next_1d(), rng.next_2d());
+                let (i, rec, w) = rs.sample_light(ref_p, u, (2, Default::default()), mis);
+                let e = &rs.emitters[i as usize];
+                let pmf = lights.pmf(i as usize);
+                assert!(pmf > 0.0);
+                if rs.is_delta_light(i) {
+                    assert_eq!(rec.pdf, 0.0);
+                    assert_eq!(rs.light_pdf(i, &rec), 0.0);
+                    continue;
+                }
+                if w == Vec3::ZERO {
+                    continue;
+                }
+                let single = e.pdf(&rs.scene, &rec);
+                assert!(close(rec.pdf, pmf * single, REL), "pmf·pdf");
+                if mis {
+                    assert!(
+                        close(rs.light_pdf(i, &rebuilt(e, &rec)), rec.pdf, REL),
+                        "light_pdf"
+                    );
+                }
+                let le = e.eval(&rs.scene, &rec);
+                assert!(
+                    close3(w, le / rec.pdf, REL),
+                    "weight {w} vs Le/(pmf·pdf) {}",
+                    le / rec.pdf
+                );
             }
-            if w == Vec3::ZERO {
-                continue;
-            }
-            let single = e.pdf(&rs.scene, &rec);
-            assert!(close(rec.pdf, pmf * single, REL), "pmf·pdf");
-            assert!(
-                close(rs.light_pdf(i, &rebuilt(e, &rec)), rec.pdf, REL),
-                "light_pdf"
-            );
-            let le = e.eval(&rs.scene, &rec);
-            assert!(
-                close3(w, le / rec.pdf, REL),
-                "weight {w} vs Le/(pmf·pdf) {}",
-                le / rec.pdf
-            );
         }
     }
+}
+
+#[test]
+fn a_constant_world_is_left_to_bsdf_sampling_under_mis() {
+    // emitter_scene's background is a constant colour: emitter sampling alone chooses it,
+    // emitter sampling under MIS never does (density zero, so BSDF samples that escape get
+    // weight one), and the other lights share its probability.
+    let rs = RenderScene::new(emitter_scene(), LightChoice::Power);
+    let b = rs.background.expect("the scene has a background") as usize;
+    assert!(rs.light_choice(false).pmf(b) > 0.0);
+    assert_eq!(rs.light_choice(true).pmf(b), 0.0);
+    let rec = EmitterQueryRecord::from_ref(Vec3::ZERO);
+    let mut escaped = rec;
+    escaped.wi = v(0.0, 0.0, 1.0);
+    assert_eq!(rs.light_pdf(b as u32, &escaped), 0.0);
+    let total: f32 = (0..rs.emitters.len())
+        .map(|i| rs.light_choice(true).pmf(i))
+        .sum();
+    assert!(close(total, 1.0, 1e-5), "{total}");
+    let mut rng = Sampler::new(401, 0, 0);
+    let mut chosen = [0u32; 2];
+    for _ in 0..4000 {
+        for (k, mis) in [false, true].into_iter().enumerate() {
+            let u = (rng.next_1d(), rng.next_2d());
+            let (i, _, _) = rs.sample_light(Vec3::ZERO, u, (2, Default::default()), mis);
+            chosen[k] += (i as usize == b) as u32;
+        }
+    }
+    assert!(chosen[0] > 0, "emitter sampling alone finds the world");
+    assert_eq!(
+        chosen[1], 0,
+        "emitter sampling under MIS leaves it to the BSDF"
+    );
 }
 
 #[test]

@@ -776,7 +776,7 @@ pub fn sample_emitter_towards(
     let none = (Vec3::ZERO, Vec3::ZERO);
     let uc = ctx.sampler.next_1d();
     let u = ctx.sampler.next_2d();
-    let (light, rec, weight) = scene.sample_light(its.p, uc, u, ctx.light_sample_at());
+    let (light, rec, weight) = scene.sample_light(its.p, (uc, u), ctx.light_sample_at(), mis);
     if weight == Vec3::ZERO || !scene.light_reaches(light, sp.light_class()) {
         return none;
     }
