@@ -527,14 +527,14 @@ impl LightParts {
         let emitter_accel = emitter_accel(scene, &mesh_emitter, triangles);
         let powers: Vec<f32> = emitters.iter().map(|e| e.power(scene, radius)).collect();
         let bounds: Vec<_> = emitters.iter().map(|e| light_bounds(scene, e)).collect();
-        let lights = LightSampler::with_bounds(&powers, &bounds, choice);
+        let lights = LightSampler::with_bounds(&powers, &bounds, radius, choice);
         let constant_world = background
             .filter(|&b| matches!(emitters[b as usize], EmitterInstance::Background(_)))
             .filter(|&b| powers[b as usize] > 0.0);
         let mis_lights = constant_world.map(|b| {
             let mut powers = powers.clone();
             powers[b as usize] = 0.0;
-            LightSampler::with_bounds(&powers, &bounds, choice)
+            LightSampler::with_bounds(&powers, &bounds, radius, choice)
         });
         LightParts {
             emitter_accel,

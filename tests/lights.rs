@@ -727,11 +727,12 @@ fn many_lights_scene() -> Scene {
     s
 }
 
-#[test]
-fn light_tree_is_unbiased_and_less_noisy() {
-    let rs = RenderScene::new(many_lights_scene(), LightChoice::Power);
+/// Renders `scene` with the light tree and with the flat choice by power: both must agree
+/// with a long flat reference (t-tests over 8 seeds), the tree with less squared error.
+fn tree_against_flat(scene: fn() -> Scene) {
+    let rs = RenderScene::new(scene(), LightChoice::Power);
     assert!(rs.lights.uses_tree());
-    let flat = RenderScene::new(many_lights_scene(), LightChoice::Flat);
+    let flat = RenderScene::new(scene(), LightChoice::Flat);
     assert!(!flat.lights.uses_tree());
     let stats = |rs: &RenderScene, seed: u64, spp: u32| {
         let opts = RenderOptions {
@@ -792,4 +793,67 @@ fn light_tree_is_unbiased_and_less_noisy() {
         err_t < err_f,
         "the tree is not less noisy: {err_t} vs {err_f}"
     );
+}
+
+#[test]
+fn light_tree_is_unbiased_and_less_noisy() {
+    tree_against_flat(many_lights_scene);
+}
+
+/// A floor under a sun and one lamp just above it: the lamp's power is a sliver of the sun's
+/// over the whole scene, yet it outshines the sun where the camera looks.
+fn lamp_and_sun_scene() -> Scene {
+    let mut s = floor_scene(2.0);
+    if let Some(c) = &mut s.camera {
+        c.projection = Projection::Perspective {
+            yfov: 60f32.to_radians(),
+        };
+    }
+    s.lights
+        .push(blender(point(v(0.5, 0.8, 0.3), 30.0, 0.1, false)));
+    s.lights.push(blender(LightShape::Sun {
+        direction: v(0.3, -1.0, 0.2).normalize(),
+        irradiance: Vec3::splat(0.5),
+        angle: 0.1,
+    }));
+    s
+}
+
+#[test]
+fn a_lamp_beside_a_sun_is_chosen_by_what_it_gives_the_point() {
+    tree_against_flat(lamp_and_sun_scene);
+    let rs = RenderScene::new(lamp_and_sun_scene(), LightChoice::Power);
+    let (lamp, sun) = (0usize, 1usize);
+    assert!(matches!(rs.emitters[sun], EmitterInstance::Directional(_)));
+    // By power over the scene the sun takes nearly every shadow ray; under the lamp the tree
+    // gives the lamp most of them, and fewer the farther the point.
+    assert!(rs.lights.pmf(lamp) < 0.05, "{}", rs.lights.pmf(lamp));
+    let shares: Vec<f32> = [0.0, 2.0, 10.0, 40.0]
+        .iter()
+        .map(|&x| rs.lights.pmf_at(v(0.5 + x, 0.0, 0.3), lamp))
+        .collect();
+    println!("lamp's share at 0, 2, 10, 40 from it: {shares:?}");
+    assert!(shares[0] > 0.9, "{shares:?}");
+    assert!(shares.windows(2).all(|w| w[1] < w[0]), "{shares:?}");
+    assert!(shares[3] < 0.5, "{shares:?}");
+    // The point's probabilities sum to one and are what sampling does.
+    let mut rng = Sampler::new(77, 0, 0);
+    for &x in &[0.0f32, 3.0, 12.0] {
+        let p = v(0.5 + x, 0.0, 0.3);
+        let total = rs.lights.pmf_at(p, lamp) + rs.lights.pmf_at(p, sun);
+        assert!((total - 1.0).abs() < 1e-5, "{total}");
+        let n = 20_000;
+        let mut lamp_count = 0u32;
+        for _ in 0..n {
+            let (i, pmf) = rs.lights.sample_at(p, rng.next_1d()).unwrap();
+            assert!((pmf - rs.lights.pmf_at(p, i)).abs() <= 1e-5 * pmf.max(1.0));
+            lamp_count += (i == lamp) as u32;
+        }
+        let q = rs.lights.pmf_at(p, lamp) as f64;
+        let z = (lamp_count as f64 - n as f64 * q) / (n as f64 * q * (1.0 - q)).sqrt().max(1e-9);
+        assert!(
+            z.abs() < 4.0,
+            "at {p}: lamp chosen {lamp_count} of {n}, pmf {q}"
+        );
+    }
 }

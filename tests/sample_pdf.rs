@@ -705,7 +705,7 @@ fn light_choice_is_folded_into_the_reported_pdf() {
                 let u = (rng.next_1d(), rng.next_2d());
                 let (i, rec, w) = rs.sample_light(ref_p, u, (2, Default::default()), mis);
                 let e = &rs.emitters[i as usize];
-                let pmf = lights.pmf(i as usize);
+                let pmf = lights.pmf_at(ref_p, i as usize);
                 assert!(pmf > 0.0);
                 if rs.is_delta_light(i) {
                     assert_eq!(rec.pdf, 0.0);

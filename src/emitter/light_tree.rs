@@ -192,6 +192,13 @@ impl LightTree {
         bounds
     }
 
+    /// The importance of the whole tree for a point at `p` ([`LightBounds::importance`] of
+    /// its root; zero for an empty tree).
+    #[inline]
+    pub fn importance(&self, p: Vec3) -> f32 {
+        self.nodes.first().map_or(0.0, |n| n.bounds.importance(p))
+    }
+
     /// Chooses an item for a point at `p`: `(item, probability)`, or `None` when no light can
     /// reach `p`.
     #[inline]

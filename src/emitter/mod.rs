@@ -193,9 +193,9 @@ pub fn luminance(c: Vec3) -> f32 {
 /// How the integrators choose one light for a shadow ray.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum LightChoice {
-    /// Proportional to each emitter's power; in scenes with at least [`TREE_MIN_LIGHTS`]
-    /// lights at finite positions, through a light tree that also weighs their distance and
-    /// orientation at each shading point.
+    /// Proportional to each emitter's power, refined per shading point by a light tree over
+    /// the lights at finite positions that weighs their distance and orientation, against the
+    /// lights at infinity by what each gives the point (see [`LightSampler::with_bounds`]).
     #[default]
     Power,
     /// Proportional to power, never through a light tree.
@@ -204,7 +204,8 @@ pub enum LightChoice {
     Uniform,
 }
 
-/// With this many lights at finite positions or more, [`LightChoice::Power`] uses a light tree.
+/// With this many lights at finite positions or more, [`LightChoice::Power`] uses a light tree
+/// even without lights at infinity.
 pub const TREE_MIN_LIGHTS: usize = 8;
 
 /// A discrete distribution over the scene's emitters, possibly depending on the shading point.
@@ -214,19 +215,41 @@ pub struct LightSampler {
     tree: Option<TreeChoice>,
 }
 
-/// Lights at finite positions in a light tree; the others (at infinity) chosen by power, against
-/// the tree as a whole by its total power.
+/// Lights at finite positions in a light tree; the others (at infinity) chosen among
+/// themselves by power, and against the tree as a group by importance at the point.
 #[derive(Clone, Debug)]
 struct TreeChoice {
     tree: light_tree::LightTree,
     /// Tree item → emitter, and emitter → tree item (`u32::MAX`: not in the tree).
     emitter_of: Vec<u32>,
     item_of: Vec<u32>,
-    /// Entries: the emitters at infinity, then the tree.
-    top: DiscreteCdf,
-    /// Top entry → emitter (`u32::MAX` for the tree), and emitter → top entry.
-    top_emitter: Vec<u32>,
-    top_of: Vec<u32>,
+    /// The emitters at infinity by power; entry → emitter, and emitter → entry.
+    infinite: DiscreteCdf,
+    infinite_emitter: Vec<u32>,
+    infinite_of: Vec<u32>,
+    /// The importance of the emitters at infinity against the tree's: the irradiance they
+    /// give a facing surface, `E = power / (π r²)` (their power is what falls on a disc of
+    /// the scene's radius `r`). The tree's `Φ / d²` is π times the irradiance of a facing
+    /// emitter of power `Φ`, so a lamp counts π times a sun of equal irradiance: the lamp's
+    /// importance is an upper bound and a sun is often shadowed indoors, and Cycles' light
+    /// tree gives its distant lights the same handicap.
+    infinite_importance: f32,
+}
+
+impl TreeChoice {
+    /// Probability of choosing from the tree (rather than a light at infinity) at `p`.
+    #[inline]
+    fn tree_share(&self, p: Vec3) -> f32 {
+        if self.infinite_importance <= 0.0 {
+            return 1.0;
+        }
+        let wt = self.tree.importance(p);
+        if wt > 0.0 {
+            wt / (wt + self.infinite_importance)
+        } else {
+            0.0
+        }
+    }
 }
 
 impl LightSampler {
@@ -248,12 +271,17 @@ impl LightSampler {
         }
     }
 
-    /// Builds the distribution for `choice`, with a light tree over the emitters that have
-    /// `bounds` (their `phi` their power) when `choice` is [`LightChoice::Power`] and there are
-    /// enough of them.
+    /// Builds the distribution for `choice`, for emitters of power `powers` (those at infinity:
+    /// over a disc of the scene's radius `radius`). With [`LightChoice::Power`], the emitters
+    /// with `bounds` (their `phi` their power) go into a light tree when there are
+    /// [`TREE_MIN_LIGHTS`] of them, or any beside lights at infinity: a sun should not take
+    /// the shadow rays of a lamp in the room by its power over the whole scene, but by what
+    /// it gives the point against what the lamp gives it (as Cycles' light tree weighs its
+    /// distant lights).
     pub fn with_bounds(
         powers: &[f32],
         bounds: &[Option<light_tree::LightBounds>],
+        radius: f32,
         choice: LightChoice,
     ) -> Self {
         let mut flat = LightSampler::new(powers, choice);
@@ -263,16 +291,22 @@ impl LightSampler {
             .zip(powers)
             .filter(|(b, p)| b.is_some() && usable(**p))
             .count();
-        if choice != LightChoice::Power || finite < TREE_MIN_LIGHTS || flat.cdf.is_empty() {
+        let infinite = bounds
+            .iter()
+            .zip(powers)
+            .filter(|(b, p)| b.is_none() && usable(**p))
+            .count();
+        let wanted = finite >= TREE_MIN_LIGHTS || (finite > 0 && infinite > 0);
+        if choice != LightChoice::Power || !wanted || flat.cdf.is_empty() {
             return flat;
         }
         let mut items = Vec::new();
         let mut emitter_of = Vec::new();
         let mut item_of = vec![u32::MAX; powers.len()];
-        let mut top_weights = Vec::new();
-        let mut top_emitter = Vec::new();
-        let mut top_of = vec![u32::MAX; powers.len()];
-        let mut tree_power = 0.0f64;
+        let mut infinite_weights = Vec::new();
+        let mut infinite_emitter = Vec::new();
+        let mut infinite_of = vec![u32::MAX; powers.len()];
+        let mut infinite_power = 0.0f64;
         for (i, (b, &p)) in bounds.iter().zip(powers).enumerate() {
             if !usable(p) {
                 continue;
@@ -282,24 +316,28 @@ impl LightSampler {
                     item_of[i] = items.len() as u32;
                     emitter_of.push(i as u32);
                     items.push(light_tree::LightBounds { phi: p, ..*b });
-                    tree_power += p as f64;
                 }
                 None => {
-                    top_of[i] = top_weights.len() as u32;
-                    top_weights.push(p);
-                    top_emitter.push(i as u32);
+                    infinite_of[i] = infinite_weights.len() as u32;
+                    infinite_weights.push(p);
+                    infinite_emitter.push(i as u32);
+                    infinite_power += p as f64;
                 }
             }
         }
-        top_weights.push(tree_power as f32);
-        top_emitter.push(u32::MAX);
+        let r2 = if radius > 0.0 && radius.is_finite() {
+            (radius as f64) * (radius as f64)
+        } else {
+            1.0
+        };
         flat.tree = Some(TreeChoice {
             tree: light_tree::LightTree::new(&items),
             emitter_of,
             item_of,
-            top: DiscreteCdf::new(top_weights),
-            top_emitter,
-            top_of,
+            infinite: DiscreteCdf::new(infinite_weights),
+            infinite_emitter,
+            infinite_of,
+            infinite_importance: (infinite_power / (std::f64::consts::PI * r2)) as f32,
         });
         flat
     }
@@ -339,14 +377,19 @@ impl LightSampler {
         let Some(t) = &self.tree else {
             return Some(self.cdf.sample(u));
         };
-        let (k, u) = t.top.sample_reuse(u);
-        let pk = t.top.pmf(k);
-        let e = t.top_emitter[k];
-        if e != u32::MAX {
-            return Some((e as usize, pk));
+        let pt = t.tree_share(p);
+        if u < pt {
+            let u = if pt < 1.0 {
+                (u / pt).min(1.0 - f32::EPSILON / 2.0)
+            } else {
+                u
+            };
+            let (item, pmf) = t.tree.sample(p, u)?;
+            return Some((t.emitter_of[item] as usize, pt * pmf));
         }
-        let (item, pmf) = t.tree.sample(p, u)?;
-        Some((t.emitter_of[item] as usize, pk * pmf))
+        let u = ((u - pt) / (1.0 - pt)).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+        let (k, pk) = t.infinite.sample(u);
+        Some((t.infinite_emitter[k] as usize, (1.0 - pt) * pk))
     }
 
     /// The probability that [`LightSampler::sample_at`] chooses emitter `i` at `p`.
@@ -355,12 +398,12 @@ impl LightSampler {
         let Some(t) = &self.tree else {
             return self.pmf(i);
         };
-        if t.top_of[i] != u32::MAX {
-            return t.top.pmf(t.top_of[i] as usize);
+        if t.infinite_of[i] != u32::MAX {
+            return (1.0 - t.tree_share(p)) * t.infinite.pmf(t.infinite_of[i] as usize);
         }
         if t.item_of[i] == u32::MAX {
             return 0.0;
         }
-        t.top.pmf(t.top.len() - 1) * t.tree.pmf(p, t.item_of[i] as usize)
+        t.tree_share(p) * t.tree.pmf(p, t.item_of[i] as usize)
     }
 }
