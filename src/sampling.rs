@@ -101,6 +101,21 @@ pub fn square_to_regular_polygon(u: Vec2, corners: u32, rotation: f32) -> Vec2 {
     Vec2::new(c * p.x - s * p.y, s * p.x + c * p.y)
 }
 
+/// A binary choice made with one uniform number `u` in `[0, 1)`: the first part (`true`) with
+/// probability `p`, when `u < p`. Also returns `u` rescaled to `[0, 1)` within the chosen
+/// part, so the same number can drive a further choice.
+#[inline]
+pub fn pick(p: f32, u: f32) -> (bool, f32) {
+    if u < p {
+        (true, (u / p).min(1.0 - f32::EPSILON / 2.0))
+    } else {
+        (
+            false,
+            ((u - p) / (1.0 - p)).clamp(0.0, 1.0 - f32::EPSILON / 2.0),
+        )
+    }
+}
+
 /// A discrete distribution over `n` items proportional to non-negative weights (a CDF table).
 #[derive(Clone, Debug, Default)]
 pub struct DiscreteCdf {

@@ -25,6 +25,7 @@ use super::{
     Bsdf, BsdfQueryRecord, DELTA_ALPHA, Dielectric, Diffuse, Measure, Mirror, Plastic,
     RoughConductor, Translucent, fresnel,
 };
+use crate::sampling::pick;
 use glam::{Vec2, Vec3};
 
 /// A lobe that sits on top of others.
@@ -239,19 +240,6 @@ impl Layer for Sheen {
 #[inline]
 pub fn sampled_direction(rec: &BsdfQueryRecord) -> bool {
     rec.measure == Measure::SolidAngle && rec.pdf > 0.0 && rec.pdf.is_finite()
-}
-
-/// The top lobe is chosen when `u1 < p`; `u1` is then rescaled to `[0, 1)` for the lobe.
-#[inline]
-fn pick(p: f32, u1: f32) -> (bool, f32) {
-    if u1 < p {
-        (true, (u1 / p).min(1.0 - f32::EPSILON / 2.0))
-    } else {
-        (
-            false,
-            ((u1 - p) / (1.0 - p)).clamp(0.0, 1.0 - f32::EPSILON / 2.0),
-        )
-    }
 }
 
 /// `f_top + A(wi) ⊙ f_base` (see the module documentation).

@@ -8,6 +8,7 @@
 //! The importance is conservative: it is zero only where no light of the subtree can reach the
 //! point (beyond every emission cone), so the choice stays unbiased.
 
+use crate::sampling::pick;
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -225,14 +226,13 @@ impl LightTree {
                 return None;
             }
             let pa = ia / sum;
-            if u < pa {
-                u = (u / pa).min(1.0 - f32::EPSILON / 2.0);
+            let (first, rest) = pick(pa, u);
+            u = rest;
+            if first {
                 pmf *= pa;
                 ni = a;
             } else {
-                let pb = 1.0 - pa;
-                u = ((u - pa) / pb).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
-                pmf *= pb;
+                pmf *= 1.0 - pa;
                 ni = b;
             }
         }

@@ -16,7 +16,7 @@ pub mod point;
 pub mod sphere;
 pub mod spot;
 
-use crate::sampling::DiscreteCdf;
+use crate::sampling::{DiscreteCdf, pick};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 
@@ -378,18 +378,16 @@ impl LightSampler {
             return Some(self.cdf.sample(u));
         };
         let pt = t.tree_share(p);
-        if u < pt {
-            let u = if pt < 1.0 {
-                (u / pt).min(1.0 - f32::EPSILON / 2.0)
-            } else {
-                u
-            };
-            let (item, pmf) = t.tree.sample(p, u)?;
-            return Some((t.emitter_of[item] as usize, pt * pmf));
+        match pick(pt, u) {
+            (true, u) => {
+                let (item, pmf) = t.tree.sample(p, u)?;
+                Some((t.emitter_of[item] as usize, pt * pmf))
+            }
+            (false, u) => {
+                let (k, pk) = t.infinite.sample(u);
+                Some((t.infinite_emitter[k] as usize, (1.0 - pt) * pk))
+            }
         }
-        let u = ((u - pt) / (1.0 - pt)).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
-        let (k, pk) = t.infinite.sample(u);
-        Some((t.infinite_emitter[k] as usize, (1.0 - pt) * pk))
     }
 
     /// The probability that [`LightSampler::sample_at`] chooses emitter `i` at `p`.

@@ -166,12 +166,13 @@ impl ShadingPoint {
         let rest;
         let (closure, u, share) = match subsurface::split(closure, walks) {
             None => (closure, u, 1.0),
-            Some(s) if u < s.p => return Some(Self::subsurface_entry(its, d, closure, inv_p, &s)),
-            Some(s) => {
-                rest = s.rest;
-                let u = ((u - s.p) / (1.0 - s.p)).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
-                (&rest, u, 1.0 / (1.0 - s.p))
-            }
+            Some(s) => match crate::sampling::pick(s.p, u) {
+                (true, _) => return Some(Self::subsurface_entry(its, d, closure, inv_p, &s)),
+                (false, u) => {
+                    rest = s.rest;
+                    (&rest, u, 1.0 / (1.0 - s.p))
+                }
+            },
         };
         let bsdf = if caustics_off == 0 && blur == 0.0 {
             bsdf::from_closure(closure, u)
