@@ -368,7 +368,7 @@ fn render_samples(
             if transparent {
                 acc.coverage += scene.camera_coverage(ctx, ray.o, ray.d);
             }
-            if adaptive && s & 1 == 1 {
+            if adaptive && crate::film::in_half_buffer(s) {
                 acc.half += 2.0 * l;
             }
             if let Some(data) = data {
