@@ -769,12 +769,13 @@ fn area_direction_pdf(scene: &Scene, e: &AreaEmitter, ref_p: Vec3, w: Vec3) -> f
     let m = &scene.meshes[e.mesh];
     let (o, d) = (ref_p.as_dvec3(), w.as_dvec3().normalize());
     let mut sum = 0.0;
-    for tri in &m.indices {
+    for (k, tri) in m.indices.iter().enumerate() {
         let t = tri.map(|i| m.positions[i as usize].as_dvec3());
         if let Some(dist) = ray_triangle(o, d, t) {
             let ng = (t[1] - t[0]).cross(t[2] - t[0]).normalize().as_vec3();
             let p = (o + d * dist).as_vec3();
-            let rec = EmitterQueryRecord::between(ref_p, p, ng, ng, Vec2::ZERO);
+            let mut rec = EmitterQueryRecord::between(ref_p, p, ng, ng, Vec2::ZERO);
+            rec.tri = k as u32;
             sum += e.pdf(scene, &rec) as f64;
         }
     }
@@ -812,6 +813,13 @@ fn area_emitter_directions() {
         ),
         ("tent from the side", tent.clone(), true, v(0.3, 0.4, 3.0)),
         ("tent at grazing angle", tent, true, v(3.0, 0.05, 0.1)),
+        // Close to a large triangle: sampled by solid angle, nearly a hemisphere of directions.
+        (
+            "large triangle just below",
+            vec![[v(-2.0, 1.0, -1.5), v(2.0, 1.0, -1.5), v(0.0, 1.0, 2.5)]],
+            true,
+            v(0.1, 0.7, 0.0),
+        ),
     ];
     let alpha = sidak(SIGNIFICANCE, cases.len());
     for (k, (name, tris, normals, ref_p)) in cases.into_iter().enumerate() {

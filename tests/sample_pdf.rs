@@ -586,7 +586,9 @@ fn emitter_scene() -> Scene {
 fn rebuilt(e: &EmitterInstance, rec: &EmitterQueryRecord) -> EmitterQueryRecord {
     match e {
         EmitterInstance::Area(_) => {
-            EmitterQueryRecord::between(rec.ref_p, rec.p, rec.n, rec.ng, rec.uv)
+            let mut back = EmitterQueryRecord::between(rec.ref_p, rec.p, rec.n, rec.ng, rec.uv);
+            (back.tri, back.bary) = (rec.tri, rec.bary);
+            back
         }
         _ => EmitterQueryRecord::towards(rec.ref_p, rec.wi),
     }
@@ -600,8 +602,7 @@ fn emitter_sample_pdf_and_weight_agree() {
     let mut rng = Sampler::new(300, 0, 0);
     for (i, e) in rs.emitters.iter().enumerate() {
         let name = format!("emitter {i} ({})", kind(e));
-        let mut checked = 0;
-        let mut dark = 0;
+        let (mut checked, mut dark, mut solid_angle) = (0, 0, 0);
         for _ in 0..20_000 {
             let ref_p = v(6.0, 5.0, 6.0) * (rng.next_2d().extend(rng.next_1d()) - 0.5) + Vec3::Y;
             let mut rec = EmitterQueryRecord::from_ref(ref_p);
@@ -656,13 +657,39 @@ fn emitter_sample_pdf_and_weight_agree() {
                     rec.n.dot(rec.ng) >= 0.0,
                     "{name}: ng on the other side of n"
                 );
-                // The area density converted to solid angle, independently.
-                let cos = rec.ng.dot(rec.wi).abs();
-                let want = rec.dist * rec.dist / (cos * a.area);
+                // The density, independently: the triangle's share of the area over its solid
+                // angle where its longest edge is longer than the distance to its plane (and
+                // its directions are not too close to one plane), else the area density
+                // converted to solid angle.
+                let m = &scene.meshes[a.mesh];
+                let v = m.indices[rec.tri as usize].map(|i| m.positions[i as usize].as_dvec3());
+                let r = ref_p.as_dvec3();
+                let (e0, e1, e2) = (v[1] - v[0], v[2] - v[0], v[2] - v[1]);
+                let longest = e0.length().max(e1.length()).max(e2.length());
+                let n = e0.cross(e1);
+                let plane = (n.dot(v[0] - r) / n.length()).abs();
+                let [da, db, dc] = v.map(|p| (p - r).normalize());
+                let triple = da.dot(db.cross(dc)).abs();
+                let omega = 2.0 * triple.atan2(1.0 + da.dot(db) + db.dot(dc) + dc.dot(da));
+                let solid = longest > plane && triple > 1e-4;
+                let want = if solid {
+                    (0.5 * n.length() / a.area as f64 / omega) as f32
+                } else {
+                    let cos = rec.ng.dot(rec.wi).abs();
+                    rec.dist * rec.dist / (cos * a.area)
+                };
+                let near_switch =
+                    (longest / plane - 1.0).abs() < 1e-4 || (triple / 1e-4 - 1.0).abs() < 1e-2;
                 assert!(
-                    close(pdf, want, REL),
-                    "{name}: pdf {pdf} vs d²/(cos A) = {want}"
+                    near_switch || close(pdf, want, REL),
+                    "{name}: pdf {pdf} vs {want} ({})",
+                    if solid {
+                        "by solid angle"
+                    } else {
+                        "d²/(cos A)"
+                    }
                 );
+                solid_angle += solid as usize;
             } else {
                 assert!(rec.dist.is_infinite(), "{name}");
             }
@@ -671,9 +698,18 @@ fn emitter_sample_pdf_and_weight_agree() {
             }
             checked += 1;
         }
-        println!("{name}: {checked} samples checked, {dark} of them from behind a one-sided face");
+        println!(
+            "{name}: {checked} samples checked, {dark} of them from behind a one-sided face, \
+             {solid_angle} by solid angle"
+        );
         if !e.is_delta() {
             assert!(checked > 10_000, "{name}");
+        }
+        if matches!(e, EmitterInstance::Area(_)) {
+            assert!(
+                solid_angle > 100,
+                "{name}: both ways of sampling are checked"
+            );
         }
     }
 }

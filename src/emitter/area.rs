@@ -1,10 +1,16 @@
 //! Mesh area lights (the seed's core): a triangle is chosen with probability proportional to
-//! its area (a discrete CDF), then a uniform point on it from barycentrics `(u, v)`,
-//! `w = 1 - u - v`. Position, shading normal and texture coordinates are interpolated (the
-//! geometric normal stands in when the mesh has no normals). The point density is `1/A` per
-//! unit area (`A` = total area); per solid angle at the reference point it is
-//! `p_A · d² / |cos θ_l|`.
+//! its area (a discrete CDF), then a point on it. Position, shading normal and texture
+//! coordinates are interpolated (the geometric normal stands in when the mesh has no normals).
+//!
+//! The point is uniform in area, barycentrics `(u, v)`, `w = 1 - u - v`: density `1/A` per unit
+//! area (`A` = total area), per solid angle at the reference point `d² / (A |cos θ_l|)`. Where
+//! the triangle is large against its distance (its longest edge longer than the reference
+//! point's distance to its plane, Cycles' rule), `d² / cos θ_l` varies too much and the
+//! direction is drawn uniformly over the triangle's solid angle `Ω` instead: density
+//! `(A_t / A) / Ω` per solid angle for a triangle of area `A_t`
+//! ([`super::spherical_triangle`]).
 
+use super::spherical_triangle::{SphericalTriangle, barycentrics_along};
 use super::{Emitter, EmitterQueryRecord, luminance};
 use crate::sampling::{DiscreteCdf, square_to_uniform_triangle};
 use crate::scene::{Mesh, Scene};
@@ -158,26 +164,59 @@ impl AreaEmitter {
     pub fn sample_point(&self, mesh: &Mesh, u: Vec2) -> (Vec3, Vec3, Vec3, Vec2, u32, Vec2) {
         let (tri, ua, ub) = self.choose_triangle(u);
         let b = square_to_uniform_triangle(Vec2::new(ua, ub));
-        // Keep the point off the triangle's edges, where a light that touches other geometry
-        // would end its shadow ray exactly on that geometry (a leak). This trims a band of
-        // relative area 6e-5 next to the edges.
-        let (b1, b2) = (
-            b.x * (1.0 - 3.0 * EDGE_MARGIN) + EDGE_MARGIN,
-            b.y * (1.0 - 3.0 * EDGE_MARGIN) + EDGE_MARGIN,
-        );
-        let b0 = 1.0 - b1 - b2;
-        let [i0, i1, i2] = mesh.indices[tri].map(|i| i as usize);
-        let (p0, p1, p2) = (mesh.positions[i0], mesh.positions[i1], mesh.positions[i2]);
-        let p = p0 * b0 + p1 * b1 + p2 * b2;
-        let ng = (p1 - p0).cross(p2 - p0).normalize();
-        let tri = tri as u32;
-        let n = mesh.shading_normal(tri, b1, b2).unwrap_or(ng);
-        let ng = if ng.dot(n) < 0.0 { -ng } else { ng };
-        let uv = mesh
-            .interpolate(&mesh.uvs, tri, b1, b2)
-            .unwrap_or(Vec2::ZERO);
-        (p, n, ng, uv, tri, Vec2::new(b1, b2))
+        let (p, n, ng, uv, bary) = point_at(mesh, tri, b);
+        (p, n, ng, uv, tri as u32, bary)
     }
+
+    /// Triangle `tri`'s share of the mesh's area.
+    #[inline]
+    fn share(&self, mesh: &Mesh, tri: usize) -> f32 {
+        0.5 * triangle_cross(mesh, tri).length() / self.area
+    }
+
+    /// The spherical triangle of triangle `tri` seen from `ref_p` when it is sampled by solid
+    /// angle from there (see the module notes), `None` when by area.
+    #[inline]
+    fn solid_angle_sampling(mesh: &Mesh, tri: usize, ref_p: Vec3) -> Option<SphericalTriangle> {
+        let v = mesh.indices[tri].map(|i| mesh.positions[i as usize]);
+        let (e0, e1, e2) = (v[1] - v[0], v[2] - v[0], v[2] - v[1]);
+        let longest2 = e0
+            .length_squared()
+            .max(e1.length_squared())
+            .max(e2.length_squared());
+        let n = e0.cross(e1);
+        // Distance to the plane, squared: (n · (v0 − p))² / |n|².
+        let h = n.dot(v[0] - ref_p);
+        if longest2 * n.length_squared() <= h * h {
+            return None;
+        }
+        SphericalTriangle::new(ref_p, v)
+    }
+}
+
+/// The point at barycentrics `b` of triangle `tri`, moved off its edges: `(position, shading
+/// normal, geometric unit normal on the shading normal's side, uv, barycentrics)`.
+#[inline]
+fn point_at(mesh: &Mesh, tri: usize, b: Vec2) -> (Vec3, Vec3, Vec3, Vec2, Vec2) {
+    // Keep the point off the triangle's edges, where a light that touches other geometry
+    // would end its shadow ray exactly on that geometry (a leak). This trims a band of
+    // relative area 6e-5 next to the edges.
+    let (b1, b2) = (
+        b.x * (1.0 - 3.0 * EDGE_MARGIN) + EDGE_MARGIN,
+        b.y * (1.0 - 3.0 * EDGE_MARGIN) + EDGE_MARGIN,
+    );
+    let b0 = 1.0 - b1 - b2;
+    let [i0, i1, i2] = mesh.indices[tri].map(|i| i as usize);
+    let (p0, p1, p2) = (mesh.positions[i0], mesh.positions[i1], mesh.positions[i2]);
+    let p = p0 * b0 + p1 * b1 + p2 * b2;
+    let ng = (p1 - p0).cross(p2 - p0).normalize();
+    let tri = tri as u32;
+    let n = mesh.shading_normal(tri, b1, b2).unwrap_or(ng);
+    let ng = if ng.dot(n) < 0.0 { -ng } else { ng };
+    let uv = mesh
+        .interpolate(&mesh.uvs, tri, b1, b2)
+        .unwrap_or(Vec2::ZERO);
+    (p, n, ng, uv, Vec2::new(b1, b2))
 }
 
 /// The emission of `program` at barycentrics `b` of triangle `tri` of `mesh`, seen along
@@ -255,7 +294,21 @@ impl Emitter for AreaEmitter {
     #[inline]
     fn sample(&self, scene: &Scene, rec: &mut EmitterQueryRecord, u: Vec2) -> Vec3 {
         let mesh = &scene.meshes[self.mesh];
-        let (p, n, ng, uv, tri, bary) = self.sample_point(mesh, u);
+        let (tri, ua, ub) = self.choose_triangle(u);
+        // The solid-angle density, when sampled by solid angle (the same as `pdf` gives).
+        let (b, solid_pdf) = match AreaEmitter::solid_angle_sampling(mesh, tri, rec.ref_p) {
+            Some(st) => {
+                let w = st.sample(Vec2::new(ua, ub));
+                let v = mesh.indices[tri].map(|i| mesh.positions[i as usize]);
+                match barycentrics_along(rec.ref_p, w, v) {
+                    Some(b) => (b, Some(self.share(mesh, tri) / st.solid_angle())),
+                    None => return Vec3::ZERO,
+                }
+            }
+            None => (square_to_uniform_triangle(Vec2::new(ua, ub)), None),
+        };
+        let (p, n, ng, uv, bary) = point_at(mesh, tri, b);
+        let tri = tri as u32;
         let d = p - rec.ref_p;
         let dist2 = d.length_squared();
         if dist2 <= 0.0 || !dist2.is_finite() {
@@ -270,7 +323,18 @@ impl Emitter for AreaEmitter {
         rec.bary = bary;
         rec.wi = d / dist;
         rec.dist = dist;
-        rec.pdf = self.pdf(scene, rec);
+        rec.pdf = match solid_pdf {
+            Some(pdf) if rec.ng.dot(rec.wi) != 0.0 => pdf,
+            Some(_) => 0.0,
+            None => {
+                let cos = rec.ng.dot(rec.wi).abs();
+                if cos > 0.0 {
+                    dist * dist / (cos * self.area)
+                } else {
+                    0.0
+                }
+            }
+        };
         if rec.pdf <= 0.0 || !rec.pdf.is_finite() {
             return Vec3::ZERO;
         }
@@ -287,10 +351,17 @@ impl Emitter for AreaEmitter {
     }
 
     #[inline]
-    fn pdf(&self, _scene: &Scene, rec: &EmitterQueryRecord) -> f32 {
+    fn pdf(&self, scene: &Scene, rec: &EmitterQueryRecord) -> f32 {
         let cos = rec.ng.dot(rec.wi).abs();
         if cos <= 0.0 {
             return 0.0;
+        }
+        let mesh = &scene.meshes[self.mesh];
+        let tri = rec.tri as usize;
+        if tri < mesh.indices.len()
+            && let Some(st) = AreaEmitter::solid_angle_sampling(mesh, tri, rec.ref_p)
+        {
+            return self.share(mesh, tri) / st.solid_angle();
         }
         rec.dist * rec.dist / (cos * self.area)
     }

@@ -14,6 +14,7 @@ pub mod light_bvh;
 pub mod light_tree;
 pub mod point;
 pub mod sphere;
+pub mod spherical_triangle;
 pub mod spot;
 
 use crate::sampling::{DiscreteCdf, pick};
