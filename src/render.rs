@@ -356,6 +356,8 @@ fn render_samples(
             continue;
         };
         ctx.camera_end = ray.tmax.is_finite().then(|| ray.o + ray.d * ray.tmax);
+        ctx.camera_memo = data.is_some() || transparent;
+        ctx.camera_hit = None;
         let mut split = LightSplit::default();
         let l = if light {
             integrator.li_split(scene, ctx, ray.o, ray.d, &mut split)
@@ -381,6 +383,7 @@ fn render_samples(
             *rejected += 1;
         }
     }
+    (ctx.camera_memo, ctx.camera_hit) = (false, None);
     acc.next = acc.next.max(end);
 }
 

@@ -220,6 +220,15 @@ pub struct Ctx {
     /// The medium the current path segment travels in ([`crate::medium`]); clear outside
     /// interiors with a volume. Shadow rays start in it.
     pub medium: Medium,
+    /// Whether camera-ray segments are remembered in [`Ctx::camera_hit`]: the render loop
+    /// turns it on, for one sample at a time, when the film's data passes or coverage follow
+    /// the camera ray the integrator traced, so that they take its hit instead of traversing
+    /// again.
+    pub camera_memo: bool,
+    /// The last camera-ray segment traced while [`Ctx::camera_memo`] is on, `(origin,
+    /// direction, length, hit)` (a camera segment's hit depends on nothing else while the
+    /// scene stays as it is).
+    pub camera_hit: Option<(Vec3, Vec3, f32, Option<Intersection>)>,
 }
 
 /// A path vertex's index and the path's bounces of each kind before it: what an emitter's
@@ -259,6 +268,8 @@ impl Ctx {
             walks_subsurface: false,
             mis_from: None,
             medium: Medium::default(),
+            camera_memo: false,
+            camera_hit: None,
         }
     }
 
@@ -1323,13 +1334,22 @@ impl RenderScene {
             return self.intersect(ctx, o, d);
         }
         let tmax = ctx.camera_tmax(o, d);
+        if let Some((o0, d0, t0, its)) = ctx.camera_hit
+            && (o0, d0, t0) == (o, d, tmax)
+        {
+            return its;
+        }
         ctx.cast(o, d, tmax, RayKind::Closest);
         let hit = if self.hides & ray::CAMERA == 0 {
-            self.closest(ctx, o, d, tmax)?
+            self.closest(ctx, o, d, tmax)
         } else {
-            self.closest_seen(ctx, o, d, tmax, ray::CAMERA)?
+            self.closest_seen(ctx, o, d, tmax, ray::CAMERA)
         };
-        Some(self.intersection(&hit, d))
+        let its = hit.map(|h| self.intersection(&h, d));
+        if ctx.camera_memo {
+            ctx.camera_hit = Some((o, d, tmax, its));
+        }
+        its
     }
 
     /// True when nothing blocks the segment from surface point `p` (geometric normal `ng`)

@@ -181,3 +181,25 @@ fn integrators_without_a_split_say_so() {
     let img = run(&rs, &o);
     assert!(mean(&img, Pass::DiffuseColor) > 0.1);
 }
+
+#[test]
+fn data_passes_reuse_the_camera_ray() {
+    // The denoiser's guides and the other first-surface passes follow the camera ray the
+    // integrator traced: on an opaque scene they cast no ray of their own, and Combined is
+    // the same with and without them.
+    let rs = scene("cornell-box");
+    let mut o = opts(16, 4, "path_mis");
+    let stats =
+        |o: &RenderOptions| render::render(&rs, o, &AtomicBool::new(false), &|_, _, _| {}).unwrap();
+    o.passes = PassSet::default();
+    let (plain, plain_stats) = stats(&o);
+    o.passes = PassSet::parse(["denoising_albedo", "denoising_normal", "depth", "normal"]).unwrap();
+    let (with, with_stats) = stats(&o);
+    assert!(with.pixels == plain.pixels);
+    assert_eq!(
+        with_stats.rays, plain_stats.rays,
+        "rays with and without data passes"
+    );
+    // The passes are there: the box's walls have albedo and unit normals.
+    assert!(mean(&with, Pass::DenoisingAlbedo) > 0.1);
+}
