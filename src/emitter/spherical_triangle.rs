@@ -101,6 +101,9 @@ pub fn barycentrics_along(p: Vec3, w: Vec3, v: [Vec3; 3]) -> Option<Vec2> {
     let b1 = (s.dot(s1) / det).max(0.0);
     let b2 = (w.dot(s.cross(e1)) / det).max(0.0);
     let sum = b1 + b2;
+    if !sum.is_finite() {
+        return None;
+    }
     Some(if sum > 1.0 {
         Vec2::new(b1 / sum, b2 / sum)
     } else {
@@ -151,6 +154,15 @@ mod tests {
         assert!(
             SphericalTriangle::new(Vec3::new(0.2, 0.2, d), v).is_none(),
             "in the plane"
+        );
+        assert!(SphericalTriangle::new(Vec3::NAN, v).is_none());
+        // A direction along the plane meets it nowhere; one that barely leaves it, far away.
+        let o = Vec3::new(0.3, 0.3, d - 1.0);
+        assert!(barycentrics_along(o, Vec3::X, v).is_none());
+        let b = barycentrics_along(o, Vec3::new(1.0, 0.0, 1e-40), v);
+        assert!(
+            b.is_none_or(|b| b.is_finite() && b.x + b.y <= 1.0 + 1e-6),
+            "{b:?}"
         );
     }
 }
