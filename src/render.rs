@@ -333,6 +333,8 @@ fn render_samples(
     let lens = camera.has_lens();
     let adaptive = opts.adaptive.is_some();
     let light = data.is_some_and(|d| d.passes.has_light());
+    // The film's data passes and coverage follow the integrator's camera ray.
+    ctx.camera_memo = data.is_some() || transparent;
     for s in acc.next..end {
         ctx.sampler = match sampling {
             Sampling::Sobol => SobolSampler::new(opts.seed, pixel_index, s as u64),
@@ -356,7 +358,6 @@ fn render_samples(
             continue;
         };
         ctx.camera_end = ray.tmax.is_finite().then(|| ray.o + ray.d * ray.tmax);
-        ctx.camera_memo = data.is_some() || transparent;
         ctx.camera_hit = None;
         let mut split = LightSplit::default();
         let l = if light {

@@ -221,9 +221,9 @@ pub struct Ctx {
     /// interiors with a volume. Shadow rays start in it.
     pub medium: Medium,
     /// Whether camera-ray segments are remembered in [`Ctx::camera_hit`]: the render loop
-    /// turns it on, for one sample at a time, when the film's data passes or coverage follow
-    /// the camera ray the integrator traced, so that they take its hit instead of traversing
-    /// again.
+    /// turns it on while it renders a pixel's samples (clearing the memo at each sample) when
+    /// the film's data passes or coverage follow the camera ray the integrator traced, so that
+    /// they take its hit instead of traversing again.
     pub camera_memo: bool,
     /// The last camera-ray segment traced while [`Ctx::camera_memo`] is on, `(origin,
     /// direction, length, hit)` (a camera segment's hit depends on nothing else while the

@@ -168,16 +168,16 @@ impl AreaEmitter {
         (p, n, ng, uv, tri as u32, bary)
     }
 
-    /// Triangle `tri`'s share of the mesh's area.
+    /// When triangle `tri` is sampled by solid angle from `ref_p` (see the module notes): the
+    /// spherical triangle, the triangle's vertices and the density of its directions, `(A_t /
+    /// A) / Ω` per unit solid angle; `None` when it is sampled by area.
     #[inline]
-    fn share(&self, mesh: &Mesh, tri: usize) -> f32 {
-        0.5 * triangle_cross(mesh, tri).length() / self.area
-    }
-
-    /// The spherical triangle of triangle `tri` seen from `ref_p` when it is sampled by solid
-    /// angle from there (see the module notes), `None` when by area.
-    #[inline]
-    fn solid_angle_sampling(mesh: &Mesh, tri: usize, ref_p: Vec3) -> Option<SphericalTriangle> {
+    fn solid_angle_sampling(
+        &self,
+        mesh: &Mesh,
+        tri: usize,
+        ref_p: Vec3,
+    ) -> Option<(SphericalTriangle, [Vec3; 3], f32)> {
         let v = mesh.indices[tri].map(|i| mesh.positions[i as usize]);
         let (e0, e1, e2) = (v[1] - v[0], v[2] - v[0], v[2] - v[1]);
         let longest2 = e0
@@ -190,7 +190,20 @@ impl AreaEmitter {
         if longest2 * n.length_squared() <= h * h {
             return None;
         }
-        SphericalTriangle::new(ref_p, v)
+        let st = SphericalTriangle::new(ref_p, v)?;
+        let share = 0.5 * n.length() / self.area;
+        Some((st, v, share / st.solid_angle()))
+    }
+
+    /// The solid-angle density of `rec`'s point: `solid` when its triangle is sampled by
+    /// solid angle, else the area density `1/A` converted, `d² / (A |cos θ_l|)`; 0 seen edge-on.
+    #[inline]
+    fn density(&self, rec: &EmitterQueryRecord, solid: Option<f32>) -> f32 {
+        let cos = rec.ng.dot(rec.wi).abs();
+        if cos <= 0.0 {
+            return 0.0;
+        }
+        solid.unwrap_or_else(|| rec.dist * rec.dist / (cos * self.area))
     }
 }
 
@@ -296,12 +309,10 @@ impl Emitter for AreaEmitter {
         let mesh = &scene.meshes[self.mesh];
         let (tri, ua, ub) = self.choose_triangle(u);
         // The solid-angle density, when sampled by solid angle (the same as `pdf` gives).
-        let (b, solid_pdf) = match AreaEmitter::solid_angle_sampling(mesh, tri, rec.ref_p) {
-            Some(st) => {
-                let w = st.sample(Vec2::new(ua, ub));
-                let v = mesh.indices[tri].map(|i| mesh.positions[i as usize]);
-                match barycentrics_along(rec.ref_p, w, v) {
-                    Some(b) => (b, Some(self.share(mesh, tri) / st.solid_angle())),
+        let (b, solid_pdf) = match self.solid_angle_sampling(mesh, tri, rec.ref_p) {
+            Some((st, v, pdf)) => {
+                match barycentrics_along(rec.ref_p, st.sample(Vec2::new(ua, ub)), v) {
+                    Some(b) => (b, Some(pdf)),
                     None => return Vec3::ZERO,
                 }
             }
@@ -323,18 +334,7 @@ impl Emitter for AreaEmitter {
         rec.bary = bary;
         rec.wi = d / dist;
         rec.dist = dist;
-        rec.pdf = match solid_pdf {
-            Some(pdf) if rec.ng.dot(rec.wi) != 0.0 => pdf,
-            Some(_) => 0.0,
-            None => {
-                let cos = rec.ng.dot(rec.wi).abs();
-                if cos > 0.0 {
-                    dist * dist / (cos * self.area)
-                } else {
-                    0.0
-                }
-            }
-        };
+        rec.pdf = self.density(rec, solid_pdf);
         if rec.pdf <= 0.0 || !rec.pdf.is_finite() {
             return Vec3::ZERO;
         }
@@ -352,18 +352,12 @@ impl Emitter for AreaEmitter {
 
     #[inline]
     fn pdf(&self, scene: &Scene, rec: &EmitterQueryRecord) -> f32 {
-        let cos = rec.ng.dot(rec.wi).abs();
-        if cos <= 0.0 {
-            return 0.0;
-        }
         let mesh = &scene.meshes[self.mesh];
         let tri = rec.tri as usize;
-        if tri < mesh.indices.len()
-            && let Some(st) = AreaEmitter::solid_angle_sampling(mesh, tri, rec.ref_p)
-        {
-            return self.share(mesh, tri) / st.solid_angle();
-        }
-        rec.dist * rec.dist / (cos * self.area)
+        let solid = (tri < mesh.indices.len())
+            .then(|| self.solid_angle_sampling(mesh, tri, rec.ref_p))
+            .flatten();
+        self.density(rec, solid.map(|(_, _, pdf)| pdf))
     }
 
     fn power(&self, _scene: &Scene, _r: f32) -> f32 {
