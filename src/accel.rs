@@ -69,7 +69,14 @@ pub struct Accel {
     keys: Vec<[u32; 2]>,
     /// Traverse with the AVX2 node test (the CPU has it, see [`avx2_available`]).
     avx2: bool,
+    /// Prefetch what a node test finds (see [`prefetch_hits`]): the BVH is larger than
+    /// [`PREFETCH_BYTES`], so its loads miss the cache.
+    prefetch: bool,
 }
+
+/// Nodes and triangles beyond this size are traversed with prefetching: about a core's L2
+/// cache. Smaller BVHs stay in the cache, where the prefetches would only cost instructions.
+const PREFETCH_BYTES: usize = 1 << 20;
 
 /// Whether this CPU runs [`node_hits_avx2`] and the instructions the traversal compiled beside
 /// it uses (the portable build targets plain x86-64: SSE2, no POPCNT or LZCNT).
@@ -169,6 +176,54 @@ unsafe fn node_hits_avx2(node: &CwBvhNode, ray: &BvhRay, oct_inv4: u32) -> u32 {
     hits
 }
 
+/// Asks the cache for what the traversal reads next after a node test with hit mask `hits`:
+/// every hit interior child and the triangles of every hit leaf. The traversal visits them one
+/// at a time, so without this each cache miss waits for the one before; with it their misses
+/// overlap (traversal of a million triangles is bound by these loads).
+#[inline(always)]
+fn prefetch_hits(bvh: &CwBvh, tris: &[PackedTriangle], node: &CwBvhNode, hits: u32, oct_inv4: u32) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let mut children = hits >> 24;
+        while children != 0 {
+            let slot = children.trailing_zeros() ^ (oct_inv4 & 0xff);
+            let below = (node.imask as u32 & !(u32::MAX << slot)).count_ones();
+            let i = (node.child_base_idx + below) as usize;
+            if let Some(child) = bvh.nodes.get(i) {
+                let p = child as *const CwBvhNode as *const i8;
+                // SAFETY: prefetching has no architectural effect; both addresses lie in the
+                // 80-byte node (it may straddle two cache lines).
+                unsafe {
+                    _mm_prefetch::<_MM_HINT_T0>(p);
+                    _mm_prefetch::<_MM_HINT_T0>(p.add(79));
+                }
+            }
+            children &= children - 1;
+        }
+        let leaves = hits & 0x00ff_ffff;
+        if leaves != 0 {
+            let base = node.primitive_base_idx as usize;
+            let first = base + leaves.trailing_zeros() as usize;
+            let last = base + 31 - leaves.leading_zeros() as usize;
+            if last < tris.len() {
+                let (a, b) = (
+                    &tris[first] as *const PackedTriangle as *const i8,
+                    (&tris[last] as *const PackedTriangle as *const i8).wrapping_add(47),
+                );
+                let mut p = a;
+                while p <= b {
+                    // SAFETY: as above; every address lies in `tris[first..=last]`.
+                    unsafe { _mm_prefetch::<_MM_HINT_T0>(p) };
+                    p = p.wrapping_add(64);
+                }
+                // SAFETY: as above.
+                unsafe { _mm_prefetch::<_MM_HINT_T0>(b) };
+            }
+        }
+    }
+}
+
 /// Möller–Trumbore: `(t, u, v)` of the hit inside `(tmin, tmax)`, else `None`.
 #[inline(always)]
 fn intersect_triangle(
@@ -245,11 +300,12 @@ impl Accel {
                 tris: Vec::new(),
                 keys: Vec::new(),
                 avx2: false,
+                prefetch: false,
             };
         }
         let mut build_time = Duration::ZERO;
         let bvh = build_cwbvh_from_tris(&input, BvhBuildParams::medium_build(), &mut build_time);
-        let tris = bvh
+        let tris: Vec<PackedTriangle> = bvh
             .primitive_indices
             .iter()
             .map(|&i| {
@@ -268,11 +324,14 @@ impl Accel {
             .iter()
             .map(|&i| input_keys.get(i as usize).copied().unwrap_or([u32::MAX; 2]))
             .collect();
+        let bytes = bvh.nodes.len() * std::mem::size_of::<CwBvhNode>()
+            + tris.len() * std::mem::size_of::<PackedTriangle>();
         Accel {
             bvh,
             tris,
             keys,
             avx2: avx2_available(),
+            prefetch: bytes > PREFETCH_BYTES,
         }
     }
 
@@ -328,7 +387,10 @@ impl Accel {
             // SAFETY: `avx2` is only set where `avx2_available()`.
             return unsafe { self.closest_avx2(trav, o, d, tmin, tmax) };
         }
-        self.closest::<false>(trav, o, d, tmin, tmax)
+        match self.prefetch {
+            true => self.closest::<false, true>(trav, o, d, tmin, tmax),
+            false => self.closest::<false, false>(trav, o, d, tmin, tmax),
+        }
     }
 
     /// [`Accel::closest`] compiled for AVX2 and the bit instructions the traversal counts with.
@@ -342,12 +404,15 @@ impl Accel {
         tmin: f32,
         tmax: f32,
     ) -> Option<Hit> {
-        self.closest::<true>(trav, o, d, tmin, tmax)
+        match self.prefetch {
+            true => self.closest::<true, true>(trav, o, d, tmin, tmax),
+            false => self.closest::<true, false>(trav, o, d, tmin, tmax),
+        }
     }
 
     /// The BVH part of [`Accel::intersect_with`].
     #[inline(always)]
-    fn closest<const AVX2: bool>(
+    fn closest<const AVX2: bool, const PREFETCH: bool>(
         &self,
         trav: &mut Traversal,
         o: Vec3,
@@ -364,7 +429,13 @@ impl Accel {
             self.bvh,
             node,
             trav,
-            node_hits::<AVX2>(node, &ray, trav.oct_inv4),
+            {
+                let hits = node_hits::<AVX2>(node, &ray, trav.oct_inv4);
+                if PREFETCH {
+                    prefetch_hits(&self.bvh, &self.tris, node, hits, trav.oct_inv4);
+                }
+                hits
+            },
             {
                 let id = trav.primitive_id as usize;
                 let tri = &self.tris[id];
@@ -421,7 +492,10 @@ impl Accel {
             // SAFETY: `avx2` is only set where `avx2_available()`.
             return unsafe { self.any_hit_avx2(trav, o, d, tmin, tmax) };
         }
-        self.any_hit::<false>(trav, o, d, tmin, tmax)
+        match self.prefetch {
+            true => self.any_hit::<false, true>(trav, o, d, tmin, tmax),
+            false => self.any_hit::<false, false>(trav, o, d, tmin, tmax),
+        }
     }
 
     /// [`Accel::any_hit`] compiled for AVX2 and the bit instructions the traversal counts with.
@@ -435,12 +509,15 @@ impl Accel {
         tmin: f32,
         tmax: f32,
     ) -> bool {
-        self.any_hit::<true>(trav, o, d, tmin, tmax)
+        match self.prefetch {
+            true => self.any_hit::<true, true>(trav, o, d, tmin, tmax),
+            false => self.any_hit::<true, false>(trav, o, d, tmin, tmax),
+        }
     }
 
     /// The BVH part of [`Accel::occluded_with`].
     #[inline(always)]
-    fn any_hit<const AVX2: bool>(
+    fn any_hit<const AVX2: bool, const PREFETCH: bool>(
         &self,
         trav: &mut Traversal,
         o: Vec3,
@@ -458,7 +535,13 @@ impl Accel {
                 self.bvh,
                 node,
                 trav,
-                node_hits::<AVX2>(node, &ray, trav.oct_inv4),
+                {
+                    let hits = node_hits::<AVX2>(node, &ray, trav.oct_inv4);
+                    if PREFETCH {
+                        prefetch_hits(&self.bvh, &self.tris, node, hits, trav.oct_inv4);
+                    }
+                    hits
+                },
                 {
                     let tri = &self.tris[trav.primitive_id as usize];
                     if intersect_triangle(tri, ray.origin, ray.direction, ray.tmin, ray.tmax)
@@ -694,6 +777,65 @@ mod tests {
         }
         assert!(
             hits > 2000 && blocked >= hits,
+            "{hits} hits, {blocked} occluded"
+        );
+    }
+
+    #[test]
+    fn prefetching_traversal_finds_the_same_hits() {
+        // Thirty thousand triangles (1.4 MB with the nodes: above the prefetch size) in a
+        // cube, rays from inside and outside it: closest and any hits are the same, to the
+        // bit, with and without prefetching, for the AVX2 and the portable node test.
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rnd = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+        };
+        let tris: Vec<[Vec3; 3]> = (0..30_000)
+            .map(|_| {
+                let c = Vec3::new(rnd(), rnd(), rnd()) * 4.0;
+                let mut e = || Vec3::new(rnd(), rnd(), rnd()) * 0.2;
+                [c, c + e(), c + e()]
+            })
+            .collect();
+        let with = Accel::build(&tris);
+        assert!(
+            with.prefetch,
+            "30,000 triangles are traversed with prefetching"
+        );
+        let variants = [
+            with,
+            Accel {
+                prefetch: false,
+                ..Accel::build(&tris)
+            },
+            Accel::build(&tris).portable(),
+            Accel {
+                prefetch: false,
+                ..Accel::build(&tris).portable()
+            },
+        ];
+        let key = |h: Option<Hit>| h.map(|h| (h.t.to_bits(), h.key, h.u.to_bits(), h.v.to_bits()));
+        let (mut hits, mut blocked) = (0, 0);
+        for _ in 0..20_000 {
+            let o = Vec3::new(rnd(), rnd(), rnd()) * 6.0;
+            let Some(d) = Vec3::new(rnd(), rnd(), rnd()).try_normalize() else {
+                continue;
+            };
+            let tmax = 1.0 + 8.0 * rnd().abs();
+            let first = key(variants[0].intersect(o, d, 0.0, tmax));
+            let occluded = variants[0].occluded(o, d, 0.0, tmax);
+            for v in &variants[1..] {
+                assert_eq!(key(v.intersect(o, d, 0.0, tmax)), first);
+                assert_eq!(v.occluded(o, d, 0.0, tmax), occluded);
+            }
+            hits += first.is_some() as u32;
+            blocked += occluded as u32;
+        }
+        assert!(
+            hits > 5000 && blocked >= hits,
             "{hits} hits, {blocked} occluded"
         );
     }
