@@ -1,7 +1,8 @@
 //! Texture lookup: bilinear (Cycles' "Linear", no mipmaps) or nearest, with glTF wrap modes.
 //! Texture coordinates follow glTF: `(0, 0)` is the image's top-left corner.
-//! Colour (sRGB) textures are filtered on their encoded values and decoded to linear after
-//! filtering, as Cycles does with 8-bit images.
+//! Colour (sRGB) textures, 8-bit or float, are filtered on their encoded values and decoded to
+//! linear after filtering, as Cycles does with every sRGB image it reads from a file (its
+//! `compress_as_srgb`: the decode runs in the kernel, after interpolation).
 
 use crate::scene::{Image, Texture, Wrap};
 use glam::{Vec2, Vec4};
@@ -50,24 +51,15 @@ fn texel(img: &Image, x: usize, y: usize) -> Vec4 {
     Vec4::new(p[0] as f32, p[1] as f32, p[2] as f32, p[3] as f32) / 255.0
 }
 
-/// A float texel, linear (an sRGB-tagged float image is decoded per texel, before filtering,
-/// as Cycles converts float images to linear when it loads them).
+/// A float texel as stored (sRGB-encoded when the image is tagged sRGB: decoded after
+/// filtering).
 #[inline]
-fn texel_f(img: &Image, x: usize, y: usize, srgb: bool) -> Vec4 {
-    let v = Vec4::from_array(img.float[y * img.width as usize + x]);
-    if srgb {
-        Vec4::new(
-            srgb_to_linear(v.x),
-            srgb_to_linear(v.y),
-            srgb_to_linear(v.z),
-            v.w,
-        )
-    } else {
-        v
-    }
+fn texel_f(img: &Image, x: usize, y: usize) -> Vec4 {
+    Vec4::from_array(img.float[y * img.width as usize + x])
 }
 
-/// sRGB decode of a filtered encoded value in [0, 1].
+/// sRGB decode of a filtered encoded value (values above 1 follow the same power law, as
+/// Cycles' `color_srgb_to_linear` does).
 #[inline]
 fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 {
@@ -163,15 +155,14 @@ pub fn lookup(tex: &Texture, img: &Image, uv: Vec2, srgb: bool) -> Vec4 {
     let (w, h) = (img.width, img.height);
     if !img.float.is_empty() {
         if tex.nearest {
-            return filter(w, h, true, uv, |x, y| fetch_f(tex, img, x, y, srgb));
+            return decode(filter(w, h, true, uv, |x, y| fetch_f(tex, img, x, y)), srgb);
         }
         // The bilinear filter written out: the four fetches inline (a closure passed to
         // `filter` stays a call per texel).
         let (x0, y0, fx, fy) = bilinear_at(w, h, uv);
-        let top = fetch_f(tex, img, x0, y0, srgb).lerp(fetch_f(tex, img, x0 + 1, y0, srgb), fx);
-        let bottom =
-            fetch_f(tex, img, x0, y0 + 1, srgb).lerp(fetch_f(tex, img, x0 + 1, y0 + 1, srgb), fx);
-        return top.lerp(bottom, fy);
+        let top = fetch_f(tex, img, x0, y0).lerp(fetch_f(tex, img, x0 + 1, y0), fx);
+        let bottom = fetch_f(tex, img, x0, y0 + 1).lerp(fetch_f(tex, img, x0 + 1, y0 + 1), fx);
+        return decode(top.lerp(bottom, fy), srgb);
     }
     if img.rgba8.is_empty() {
         return Vec4::ONE;
@@ -198,14 +189,13 @@ fn fetch_8(tex: &Texture, img: &Image, x: i64, y: i64) -> Vec4 {
     )
 }
 
-/// The wrapped texel `(x, y)` of a float image, linear.
+/// The wrapped texel `(x, y)` of a float image, as stored.
 #[inline(always)]
-fn fetch_f(tex: &Texture, img: &Image, x: i64, y: i64, srgb: bool) -> Vec4 {
+fn fetch_f(tex: &Texture, img: &Image, x: i64, y: i64) -> Vec4 {
     texel_f(
         img,
         wrap(x, img.width, tex.wrap_s),
         wrap(y, img.height, tex.wrap_t),
-        srgb,
     )
 }
 
@@ -258,6 +248,33 @@ mod tests {
         // Filtering happens before decoding: halfway between red and green is sRGB 0.5.
         let mid = lookup(&tex, &img, Vec2::new(0.5, 0.25), true);
         assert!((mid.x - srgb_to_linear(0.5)).abs() < 1e-6, "{mid}");
+        // The same for float texels tagged sRGB (16-bit PNGs, sRGB EXRs), above 1 too: the
+        // encoded values are interpolated, then decoded.
+        let float = Image {
+            width: 2,
+            height: 1,
+            rgba8: Vec::new(),
+            float: vec![[0.0, 2.0, 0.5, 1.0], [1.0, 4.0, 0.5, 0.5]],
+        };
+        let f = lookup(&tex, &float, Vec2::new(0.5, 0.5), true);
+        let want = [
+            srgb_to_linear(0.5),
+            srgb_to_linear(3.0),
+            srgb_to_linear(0.5),
+            0.75,
+        ];
+        assert!(
+            (f - Vec4::from_array(want)).abs().max_element() < 1e-6,
+            "{f} against {want:?}"
+        );
+        let closest = Texture {
+            nearest: true,
+            ..tex.clone()
+        };
+        let c = lookup(&closest, &float, Vec2::new(0.7, 0.5), true);
+        assert!((c.y - srgb_to_linear(4.0)).abs() < 1e-5, "{c}");
+        let linear = lookup(&tex, &float, Vec2::new(0.5, 0.5), false);
+        assert!((linear - Vec4::new(0.5, 3.0, 0.5, 0.75)).length() < 1e-6);
     }
 
     #[test]

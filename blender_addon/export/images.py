@@ -32,6 +32,14 @@ def _linear_to_srgb(c):
     return np.where(c <= 0.0031308, c * 12.92, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
 
 
+def _read_from_file(image):
+    """Whether Cycles reads `image` from its file (OIIO, the file's own encoding) rather than
+    taking Blender's pixels: a file image that is not packed (generated, packed and movie
+    images come from Blender, float ones already linear)."""
+    return (getattr(image, "source", "FILE") in ("FILE", "SEQUENCE", "TILED")
+            and not getattr(image, "packed_file", None))
+
+
 class Textures:
     """Images, samplers and textures of one export; images are PNG files beside the .gltf."""
 
@@ -112,8 +120,10 @@ class ImageTable:
 
     Byte images travel as u8 (Blender's float view of the bytes x 255, rounded: exact, still in
     the image's colour space, straight alpha); float images as f32, or f16 when every value
-    survives the round trip (a half-float source), already in scene linear and premultiplied, as
-    Blender holds them (Cycles uses them as they are).
+    survives the round trip (a half-float source), in scene linear and premultiplied as Blender
+    holds them (Cycles uses them as they are), except sRGB files Cycles reads itself: their
+    pixels are encoded to sRGB again and tagged "sRGB", so the renderer filters encoded values
+    and decodes after, as Cycles does.
     """
 
     def __init__(self, buffer, report):
@@ -152,6 +162,20 @@ class ImageTable:
         rows = buf.reshape(h, w, channels)[::-1]  # Blender's rows run bottom to top
         is_float = bool(image.is_float)
         cs = image.colorspace_settings.name
+        colorspace = "Non-Color" if is_float else cs
+        if is_float and cs == "sRGB" and _read_from_file(image):
+            # Cycles reads such an image from its file and keeps it sRGB-encoded, decoding after
+            # interpolation (its compress_as_srgb); Blender's float pixels are linear, so encode
+            # them again for the renderer to filter the same values.
+            # Alpha stays associated as Cycles' loader leaves it: encoded straight colour times
+            # alpha (Blender's pixels are premultiplied linear).
+            rows = rows.copy()
+            colour = slice(0, 3) if channels >= 3 else slice(0, 1)
+            alpha = rows[..., 3:4] if channels == 4 else np.ones_like(rows[..., :1])
+            straight = np.divide(rows[..., colour], alpha, out=np.zeros_like(rows[..., colour]),
+                                 where=alpha > 0)
+            rows[..., colour] = _linear_to_srgb(straight) * alpha
+            colorspace = "sRGB"
         if is_float:
             half = rows.astype(np.float16)
             if np.array_equal(half.astype(np.float32), rows, equal_nan=True):
@@ -164,8 +188,9 @@ class ImageTable:
         view = self.buffer.add_view(np.ascontiguousarray(data).tobytes())
         entry = {"name": image.name, "width": w, "height": h, "channels": channels,
                  "component": component, "bufferView": view,
-                 # Float pixels are already scene linear (Blender converted them on load).
-                 "colorspace": "Non-Color" if is_float else cs,
+                 # Float pixels are scene linear (Blender converted them on load), but for
+                 # sRGB files Cycles reads itself (encoded again above).
+                 "colorspace": colorspace,
                  "source_colorspace": cs,
                  "alpha_mode": getattr(image, "alpha_mode", "STRAIGHT"),
                  "premultiplied": is_float}

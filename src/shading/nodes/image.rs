@@ -170,19 +170,11 @@ impl ImageOp {
             texture::lookup(&self.sampler, img, uv, self.srgb)
         } else {
             let premultiply = self.associate && byte;
-            let mut c = lookup(
-                &self.sampler,
-                img,
-                uv,
-                premultiply,
-                self.clip,
-                self.srgb,
-                self.cubic,
-            );
+            let mut c = lookup(&self.sampler, img, uv, premultiply, self.clip, self.cubic);
             if self.unassociate && c.w != 0.0 && c.w != 1.0 {
                 c = (c.truncate() / c.w).extend(c.w);
             }
-            if byte && self.srgb {
+            if self.srgb {
                 c = texture::decode(c, true);
             }
             c
@@ -190,15 +182,14 @@ impl ImageOp {
     }
 }
 
-/// Texel `(x, y)` (rows top to bottom): 8-bit ones encoded in `[0, 1]`, premultiplied in bytes
-/// as Cycles' image loader does (`c * a / 255`, integer division) when `premultiply`; float
-/// ones linear (`srgb` decodes them per texel, as [`texture::lookup`] does).
+/// Texel `(x, y)` (rows top to bottom) as stored, sRGB ones still encoded (decoded after
+/// filtering, as [`texture::lookup`] does): 8-bit ones in `[0, 1]`, premultiplied in bytes as
+/// Cycles' image loader does (`c * a / 255`, integer division) when `premultiply`.
 #[inline]
-fn texel(img: &Image, x: usize, y: usize, premultiply: bool, srgb: bool) -> Vec4 {
+fn texel(img: &Image, x: usize, y: usize, premultiply: bool) -> Vec4 {
     let i = y * img.width as usize + x;
     if let Some(f) = img.float.get(i) {
-        let v = Vec4::from_array(*f);
-        return if srgb { texture::decode(v, true) } else { v };
+        return Vec4::from_array(*f);
     }
     let [r, g, b, a] = img.rgba8[i].map(u32::from);
     if premultiply {
@@ -209,7 +200,7 @@ fn texel(img: &Image, x: usize, y: usize, premultiply: bool, srgb: bool) -> Vec4
     }
 }
 
-/// Cycles' lookup (`kernel_tex_image_interp`) at glTF `uv`, 8-bit results still encoded:
+/// Cycles' lookup (`kernel_tex_image_interp`) at glTF `uv`, sRGB results still encoded:
 /// closest or bilinear, with texels premultiplied when `premultiply`; with `clip` (Blender's
 /// CLIP), texels outside the image are transparent black, so bilinear lookups fade out over
 /// the half texel around the border.
@@ -219,7 +210,6 @@ fn lookup(
     uv: Vec2,
     premultiply: bool,
     clip: bool,
-    srgb: bool,
     cubic: bool,
 ) -> Vec4 {
     let (w, h) = (img.width, img.height);
@@ -232,7 +222,7 @@ fn lookup(
         }
         let xi = texture::wrap(x, w, tex.wrap_s);
         let yi = texture::wrap(y, h, tex.wrap_t);
-        texel(img, xi, yi, premultiply, srgb)
+        texel(img, xi, yi, premultiply)
     };
     if cubic && !tex.nearest {
         texture::filter_cubic(w, h, uv, fetch)
@@ -380,10 +370,10 @@ mod tests {
     #[test]
     fn bytes_are_premultiplied_with_truncation() {
         let img = image();
-        let c = texel(&img, 0, 0, true, false) * 255.0;
+        let c = texel(&img, 0, 0, true) * 255.0;
         // 255 * 128 / 255 = 128, 101 * 128 / 255 = 50.7 -> 50 (Cycles' integer division).
         assert_eq!(c, Vec4::new(128.0, 50.0, 0.0, 128.0));
-        let straight = texel(&img, 0, 0, false, false) * 255.0;
+        let straight = texel(&img, 0, 0, false) * 255.0;
         assert_eq!(straight, Vec4::new(255.0, 101.0, 0.0, 128.0));
     }
 
@@ -393,12 +383,12 @@ mod tests {
         let t = tex(Wrap::ClampToEdge, false);
         // Texel centres at u = 0.25 and 0.75; at u = 0 the left texel is blended half with
         // the transparent outside, at u = -0.25 (a whole half texel out) nothing is left.
-        let edge = lookup(&t, &img, Vec2::new(0.0, 0.5), false, true, false, false);
+        let edge = lookup(&t, &img, Vec2::new(0.0, 0.5), false, true, false);
         assert!((edge - Vec4::new(0.5, 101.0 / 510.0, 0.0, 64.0 / 255.0)).length() < 1e-6);
-        let out = lookup(&t, &img, Vec2::new(-0.25, 0.5), false, true, false, false);
+        let out = lookup(&t, &img, Vec2::new(-0.25, 0.5), false, true, false);
         assert_eq!(out, Vec4::ZERO);
         // EXTEND holds the edge texel instead.
-        let ext = lookup(&t, &img, Vec2::new(0.0, 0.5), false, false, false, false);
+        let ext = lookup(&t, &img, Vec2::new(0.0, 0.5), false, false, false);
         assert!((ext - Vec4::new(1.0, 101.0 / 255.0, 0.0, 128.0 / 255.0)).length() < 1e-6);
     }
 
@@ -406,9 +396,9 @@ mod tests {
     fn closest_clip_is_black_outside_only() {
         let img = image();
         let t = tex(Wrap::ClampToEdge, true);
-        let inside = lookup(&t, &img, Vec2::new(0.99, 0.5), false, true, false, false);
+        let inside = lookup(&t, &img, Vec2::new(0.99, 0.5), false, true, false);
         assert_eq!(inside, Vec4::new(0.0, 0.0, 200.0 / 255.0, 1.0));
-        let outside = lookup(&t, &img, Vec2::new(1.01, 0.5), false, true, false, false);
+        let outside = lookup(&t, &img, Vec2::new(1.01, 0.5), false, true, false);
         assert_eq!(outside, Vec4::ZERO);
     }
 }
