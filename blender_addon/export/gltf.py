@@ -273,7 +273,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             if compat.light_linking_used(obj):
                 warnings.append("light '%s': light linking is not rendered; it lights and "
                                 "shadows every object" % obj.name)
-            ext, khr = convert_light(obj.data, obj, matrix(inst.matrix_world), warnings)
+            ext, khr = convert_light(obj.data, obj, matrix(inst.matrix_world), warnings,
+                                     images)
             node = {"name": obj.name, "matrix": gltf_matrix(matrix(inst.matrix_world)),
                     "extensions": {"TESELA_light": ext}}
             used_ext.add("TESELA_light")

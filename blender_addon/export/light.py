@@ -8,6 +8,7 @@ import numpy as np
 
 from .. import compat
 from .common import color3, finite
+from .material import GRAPH_VERSION, MaterialGraph
 
 
 def _linked_node(sock):
@@ -20,16 +21,52 @@ def _linked_node(sock):
     return None
 
 
+class _LightReport:
+    """report(light_name, node, message, kind=None) for a light's node tree: each problem once,
+    as `light 'NAME': node 'NODE' (TYPE): ...`."""
+
+    def __init__(self, warnings):
+        self.warnings, self._seen = warnings, set()
+
+    def __call__(self, light_name, node, message, kind=None):
+        node_name = node if node is None or isinstance(node, str) else node.name
+        key = (light_name, node_name, kind or message)
+        if key in self._seen:
+            return
+        self._seen.add(key)
+        idname = getattr(node, "bl_idname", None)
+        where = "" if node_name is None else " node '%s'%s" % (
+            node_name, " (%s)" % idname if idname else "")
+        self.warnings.append("light '%s':%s %s" % (light_name, where, message))
+
+
+class LightGraph(MaterialGraph):
+    """A light's node tree -> a graph in TESELA_material_graph's format (`surface`: what reaches
+    the active Light Output), for the renderer to evaluate what the add-on cannot reduce."""
+
+    def build(self):
+        graph = {"version": GRAPH_VERSION, "nodes": self.nodes, "surface": None}
+        out = _light_output(self.material.node_tree)
+        if out is not None:
+            graph["surface"] = self._root(out, "Surface")
+        return graph
+
+
+def _light_output(tree):
+    outs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputLight"]
+    return next((n for n in outs if n.is_active_output), outs[0] if outs else None)
+
+
 def node_emission(light, name, warn):
     """The factor a light's node tree puts on its colour: Cycles multiplies the light's own
     strength by what its shader emits. Emission's unlinked Color x Strength, and Light Falloff's
     Quadratic (the physical falloff) into Strength; anything else renders with those unlinked
-    values and is reported."""
+    values and is reported through `warn` (the renderer may still evaluate the tree itself:
+    see convert_light)."""
     nt = light.node_tree if getattr(light, "use_nodes", False) else None
     if nt is None:
         return (1.0, 1.0, 1.0)
-    outs = [n for n in nt.nodes if n.bl_idname == "ShaderNodeOutputLight"]
-    out = next((n for n in outs if n.is_active_output), outs[0] if outs else None)
+    out = _light_output(nt)
     if out is None:
         return (1.0, 1.0, 1.0)
     node = _linked_node(out.inputs["Surface"])
@@ -61,13 +98,25 @@ def node_emission(light, name, warn):
     return tuple(v * k for v in c)
 
 
-def convert_light(light, obj, matrix=None, warnings=None):
+def convert_light(light, obj, matrix=None, warnings=None, images=None):
+    """TESELA_light and a KHR_lights_punctual copy of `light` placed by `obj`. With `images`
+    (the export's ImageTable), a node tree the add-on cannot reduce to a colour also travels as
+    a graph: the renderer evaluates it when it is constant over the light (a Blackbody into the
+    Emission), and otherwise gives `node_warnings` and renders `color` (the unlinked values)."""
     t = light.type
-    color, scale = compat.light_color_and_scale(light)
-    factor = node_emission(light, obj.name, warnings.append if warnings is not None
-                           else (lambda _m: None))
-    color = [c * f for c, f in zip(color[:3], factor)]
+    base, scale = compat.light_color_and_scale(light)
+    notes = []
+    factor = node_emission(light, obj.name, notes.append)
+    color = [c * f for c, f in zip(base[:3], factor)]
     ext = {"type": t, "color": color3(color)}
+    if notes and images is not None and light.node_tree is not None:
+        graph_warnings = []
+        ext["graph"] = LightGraph(light, images, _LightReport(graph_warnings)).build()
+        ext["base_color"] = color3(base[:3])
+        ext["node_warnings"] = notes
+        notes = graph_warnings
+    if warnings is not None:
+        warnings.extend(notes)
     energy = finite(light.energy) * scale
     if t == "SUN":
         ext["strength"] = energy

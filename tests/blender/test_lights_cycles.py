@@ -105,6 +105,36 @@ def light_nodes():
     return info
 
 
+def light_nodes_evaluated():
+    """Light node trees only the renderer can reduce: a spot coloured by a Blackbody node
+    (3200 K) into its Emission, and an area light whose Emission colour is an RGB node times a
+    Math node's strength, through a reroute (constant trees: Cycles multiplies the light's
+    strength by what they emit)."""
+    info = _plane_with_box()
+    spot = scenes.add_spot_light("Warm", (0.2, -0.4, 2.2), (-0.3, 0.3, 0.0), 150.0,
+                                 math.radians(60.0), blend=0.3, radius=0.1)
+    spot.data.use_nodes = True
+    nt = spot.data.node_tree
+    em = next(n for n in nt.nodes if n.bl_idname == "ShaderNodeEmission")
+    bb = nt.nodes.new("ShaderNodeBlackbody")
+    bb.inputs["Temperature"].default_value = 3200.0
+    nt.links.new(bb.outputs["Color"], em.inputs["Color"])
+    area = scenes.add_area_light("Cool", (-0.8, 1.0, 1.6), (0.0, 0.0, 0.0), 60.0, 0.6)
+    area.data.use_nodes = True
+    nt = area.data.node_tree
+    em = next(n for n in nt.nodes if n.bl_idname == "ShaderNodeEmission")
+    rgb = nt.nodes.new("ShaderNodeRGB")
+    rgb.outputs[0].default_value = (0.2, 0.5, 1.0, 1.0)
+    reroute = nt.nodes.new("NodeReroute")
+    nt.links.new(rgb.outputs[0], reroute.inputs[0])
+    nt.links.new(reroute.outputs[0], em.inputs["Color"])
+    math_node = nt.nodes.new("ShaderNodeMath")
+    math_node.operation = "MULTIPLY"
+    math_node.inputs[0].default_value, math_node.inputs[1].default_value = 1.5, 2.0
+    nt.links.new(math_node.outputs[0], em.inputs["Strength"])
+    return info
+
+
 def sun_angle():
     """A 25° sun whose soft shadow of the box falls towards the camera."""
     info = scenes.light_over_plane("sun", sun_strength=3.0)
@@ -205,6 +235,7 @@ CASES = [
     ("spot_radius_soft", spot_radius_soft, 0, "direct_mis", 512),
     ("sun_angle", sun_angle, 0, "direct_mis", 512),
     ("light_node_trees", light_nodes, 0, "direct_mis", 512),
+    ("light_node_trees_evaluated", light_nodes_evaluated, 0, "direct_mis", 512),
     ("lights_in_a_mirror", lights_seen_in_a_mirror, 1, "path_mis", 512),
     ("sun_in_a_mirror", sun_in_a_mirror, 1, "path_mis", 256),
     ("area_square_spread60", area_spread("SQUARE", 60.0), 0, "direct_mis", 512),
@@ -284,10 +315,12 @@ def test_light_fields_are_exported(addon, tmp_path):  # noqa: F811
     assert sun["angle"] == pytest.approx(math.radians(5.0)) and sun["visible_transmission"] is False
 
 
-def test_light_node_trees_are_read_or_reported(addon, tmp_path):  # noqa: F811
-    """A light's Emission Color x Strength scales its colour; what the renderer cannot read
-    from its node tree is reported, naming the light and the node."""
+def test_light_node_trees_are_read_or_reported(addon, tesela_bin, tmp_path):  # noqa: F811
+    """A light's Emission Color x Strength scales its colour; a tree the add-on cannot reduce
+    travels as a graph, and what the renderer cannot evaluate either (a texture: it varies over
+    the light) is reported by the renderer, naming the light and the node."""
     import json
+    import subprocess
 
     from blender_addon import export
 
@@ -307,7 +340,13 @@ def test_light_node_trees_are_read_or_reported(addon, tmp_path):  # noqa: F811
     doc = json.loads(path.read_text(encoding="utf-8"))
     light = next(n["extensions"]["TESELA_light"] for n in doc["nodes"] if n["name"] == "Lamp")
     assert light["color"] == pytest.approx([1.5, 3.0, 1.5])
-    assert any("light 'Lamp'" in w and tex.name in w for w in res.warnings), res.warnings
+    assert light["base_color"] == pytest.approx([1.0, 1.0, 0.5]) and light["graph"]["surface"]
+    assert any("light 'Lamp'" in w and tex.name in w for w in light["node_warnings"]), light
+    assert not any(tex.name in w for w in res.warnings), "the renderer decides, and reports"
+    run = subprocess.run([str(tesela_bin), "render", str(path), "-o", str(tmp_path / "l.exr"),
+                          "--spp", "1"], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert "light 'Lamp'" in run.stderr and tex.name in run.stderr, run.stderr
 
 
 def test_portals_are_left_out_and_light_linking_and_motion_blur_reported(addon, tmp_path):  # noqa: F811

@@ -26,6 +26,39 @@ impl<'a> Loader<'a> {
             .is_some_and(|g| g.starts_with("Khronos glTF Blender I/O"))
     }
 
+    /// The colour of a `TESELA_light`: `color`, or with a node tree that the add-on could not
+    /// reduce (`graph`, with `base_color`, the light's own colour), `base_color` times what
+    /// the tree emits when that is a constant (a Blackbody or an RGB node into the Emission:
+    /// Cycles multiplies the light's strength by its shader's emission). A tree that varies
+    /// over the light keeps `color` (the unlinked values) and its `node_warnings` are given.
+    fn light_node_color(&mut self, ni: usize, t: &Value) -> Vec3 {
+        let color = rgb(t, "color").unwrap_or(Vec3::ONE);
+        let Some(g) = member(t, "graph").filter(|g| !g.is_null()) else {
+            return color;
+        };
+        let name = member(self.raw_item("nodes", ni), "name")
+            .and_then(Value::as_str)
+            .map_or_else(|| format!("node {ni}"), str::to_string);
+        let emitted = crate::shading::Graph::from_json(g).ok().and_then(|graph| {
+            // Images vary over the light (and are not resolved here).
+            if graph.nodes.iter().any(|n| n.props.contains_key("image")) {
+                return None;
+            }
+            let compiled = crate::shading::compile::compile(&graph, &name).ok()?;
+            compiled.program.constant_set().map(|set| set.emission)
+        });
+        match (emitted, rgb(t, "base_color")) {
+            (Some(e), Some(base)) if valid_color(e) => base * e,
+            _ => {
+                let notes = member(t, "node_warnings").and_then(Value::as_array);
+                for m in notes.into_iter().flatten().filter_map(Value::as_str) {
+                    self.warn_once(m.to_string());
+                }
+                color
+            }
+        }
+    }
+
     pub(crate) fn node_lights(&mut self, ni: usize, world: Mat4) -> Result<(), LoadError> {
         let raw_node = self.raw_item("nodes", ni);
         if let Some(t) = extension(raw_node, "TESELA_light") {
@@ -117,7 +150,7 @@ impl<'a> Loader<'a> {
 
     fn tesela_light(&mut self, ni: usize, world: Mat4, t: &Value) -> Result<(), LoadError> {
         let ty = member(t, "type").and_then(Value::as_str).unwrap_or("");
-        let color = rgb(t, "color").unwrap_or(Vec3::ONE);
+        let color = self.light_node_color(ni, t);
         let f = |k: &str, d: f32| num(t, k).map(|v| v as f32).unwrap_or(d);
         let flag = |k: &str| member(t, k).and_then(Value::as_bool).unwrap_or(true);
         let visibility = LightVisibility {
