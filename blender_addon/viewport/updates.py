@@ -111,7 +111,13 @@ def _world_command(world, out):
 
 def light_fields(obj, warnings):
     mw = matrix(obj.matrix_world)
-    ext, _ = export.convert_light(obj.data, obj, mw, warnings)
+    images = export.ImageTable(export.Buffer(), export.MaterialReport(warnings, {}))
+    ext, _ = export.convert_light(obj.data, obj, mw, warnings, images)
+    if images.images:
+        # A light command carries no pixels: a tree reading an image renders its unlinked
+        # values (the renderer would not evaluate an image on a light anyway).
+        ext.pop("graph", None)
+        warnings.extend(ext.pop("node_warnings", []))
     return {"node": obj.name, "light": ext, "matrix": gltf_matrix(mw)}
 
 

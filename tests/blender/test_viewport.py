@@ -696,3 +696,26 @@ def test_real_session_takes_every_edit(monkeypatch, tmp_path):
     finally:
         bpy.app.handlers.depsgraph_update_post.remove(handler)
         vs.close()
+
+
+
+def test_light_edit_carries_its_node_tree():
+    """A light edited in the viewport carries the node tree the add-on cannot reduce (a
+    Blackbody colour) for the session's renderer to evaluate, as a render's export does."""
+    for ob in list(bpy.data.objects):
+        bpy.data.objects.remove(ob)
+    data = bpy.data.lights.new("Warm", "POINT")
+    ob = bpy.data.objects.new("Warm", data)
+    bpy.context.scene.collection.objects.link(ob)
+    data.use_nodes = True
+    nt = data.node_tree
+    em = next(n for n in nt.nodes if n.bl_idname == "ShaderNodeEmission")
+    bb = nt.nodes.new("ShaderNodeBlackbody")
+    bb.inputs["Temperature"].default_value = 3200.0
+    nt.links.new(bb.outputs["Color"], em.inputs["Color"])
+    warnings = []
+    light = updates.light_fields(ob, warnings)["light"]
+    assert warnings == [], warnings
+    types = [n["type"] for n in light["graph"]["nodes"]]
+    assert "ShaderNodeBlackbody" in types and light["graph"]["surface"], light
+    assert light["base_color"] == [1.0, 1.0, 1.0]

@@ -467,6 +467,56 @@ fn tesela_light_overrides_the_khr_copy() {
 }
 
 #[test]
+fn a_light_node_graph_is_evaluated_when_constant() {
+    // The add-on's light graph: Blackbody (3200 K) into the Emission, strength 2 (constant:
+    // the colour is base_color x its emission); a Noise Texture on the strength varies over
+    // the light: the fallback `color` and the warnings.
+    let graph = |strength: Value| {
+        json!({"version": 1, "surface": [1, "Emission"], "nodes": [
+            {"name": "Blackbody", "type": "ShaderNodeBlackbody", "props": {},
+             "inputs": {"Temperature": 3200.0}, "internal_links": {}},
+            {"name": "Emission", "type": "ShaderNodeEmission", "props": {},
+             "inputs": {"Color": {"link": [0, "Color"]}, "Strength": strength},
+             "internal_links": {}},
+            {"name": "Noise Texture", "type": "ShaderNodeTexNoise", "props": {},
+             "inputs": {}, "internal_links": {}}]})
+    };
+    let light = |strength: Value| {
+        json!({ "TESELA_light": { "type": "POINT", "power": 100.0, "color": [0.5, 0.5, 0.5],
+                                  "base_color": [1.0, 1.0, 0.5], "graph": graph(strength),
+                                  "node_warnings": ["light 'Lamp': not rendered"] } })
+    };
+    let noise = json!({"link": [2, "Fac"]});
+    let bytes = lights_doc(
+        None,
+        json!([{ "extensions": light(json!(2.0)) }, { "extensions": light(noise) }]),
+        json!([]),
+    );
+    let s = load(&bytes);
+    let warnings = &s.warnings;
+    let intensity = |i: usize| match &s.lights[i] {
+        Light::Blender {
+            shape: LightShape::Point { intensity, .. },
+            ..
+        } => *intensity * (4.0 * std::f32::consts::PI) / 100.0,
+        l => panic!("{l:?}"),
+    };
+    let warm = intensity(0);
+    // Blackbody 3200 K is orange: red well above blue, and the strength 2 and the base colour
+    // (blue halved) multiply it.
+    assert!(warm.x > 2.0 * warm.z && warm.x > 1.0, "{warm}");
+    assert!((intensity(1) - Vec3::splat(0.5)).abs().max_element() < 1e-5);
+    assert_eq!(
+        warnings
+            .iter()
+            .filter(|w| w.contains("light 'Lamp'"))
+            .count(),
+        1,
+        "{warnings:?}"
+    );
+}
+
+#[test]
 fn tesela_area_lights_keep_their_shape() {
     // A 2 m square under a node scaled by 2 and turned to face down (-Z -> -Y).
     let rot = Quat::from_rotation_x(-FRAC_PI_2);
