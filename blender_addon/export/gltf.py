@@ -52,6 +52,19 @@ class Geometry:
                         self.texspace)
 
 
+
+def _rendered_hair(obj):
+    """Names of the hair particle systems of `obj` that Cycles renders as strands (enabled for
+    renders, drawn as paths; object and collection hair arrive as instances)."""
+    names = []
+    for mod in getattr(obj, "modifiers", ()):
+        if mod.type != "PARTICLE_SYSTEM" or not getattr(mod, "show_render", True):
+            continue
+        ps = mod.particle_system
+        if ps.settings.type == "HAIR" and ps.settings.render_type == "PATH":
+            names.append(ps.name)
+    return names
+
 def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settings=None,
                check_cancel=None, selection=None, mesh_store=None):
     """Write the evaluated scene of `depsgraph` to `filepath` (.gltf) + a .bin beside it.
@@ -219,6 +232,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
         return mesh_cache[key]
 
     skipped_types = set()
+    hair_reported = set()
     count = 0
     for inst in depsgraph.object_instances:
         count += 1
@@ -235,6 +249,13 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             elif orig.name not in selection:
                 continue
         otype = obj.type
+        if otype in MESHLIKE and obj.name not in hair_reported:
+            hair = _rendered_hair(obj)
+            if hair:
+                hair_reported.add(obj.name)
+                warnings.append("object '%s': hair (particle system %s) is not rendered; its "
+                                "strands are left out" % (obj.name, ", ".join(
+                                    "'%s'" % h for h in hair)))
         if otype in MESHLIKE and not compat.row_is_geometry(obj):
             continue
         if otype in MESHLIKE and not getattr(inst, "show_self", True):

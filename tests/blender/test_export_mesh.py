@@ -285,3 +285,28 @@ def test_fast_reads_match_the_item_by_item_api(clean):
     placed = compat._read_in_place(me.vertices, nv, np.float32, 3, "co")
     assert placed is not None and np.array_equal(placed.reshape(-1), co)
     assert compat._read_in_place(me.vertices, nv, np.float32, 3, "normal") is None
+
+
+def test_hair_particle_systems_are_reported(tmp_path):
+    """Hair strands (a particle system drawn as paths) are not rendered: the export says so once,
+    naming the object and the system; the emitter itself is still exported, and a system
+    disabled for renders, or emitter particles, say nothing."""
+    from blender_addon import export
+
+    scenes.clear_scene()
+    ob = scenes.add_sphere("Furry", (0, 0, 0), 0.5)
+    hair = ob.modifiers.new("Fur", "PARTICLE_SYSTEM").particle_system
+    hair.name = "Fur"
+    hair.settings.type, hair.settings.count = "HAIR", 50
+    off = scenes.add_sphere("Shaved", (2, 0, 0), 0.5)
+    mod = off.modifiers.new("Off", "PARTICLE_SYSTEM")
+    mod.particle_system.settings.type = "HAIR"
+    mod.show_render = False
+    dust = scenes.add_sphere("Dusty", (-2, 0, 0), 0.5)
+    dust.modifiers.new("Dust", "PARTICLE_SYSTEM").particle_system.settings.type = "EMITTER"
+    scenes.add_camera((0, -5, 0), (0, 0, 0))
+    dg = bpy.context.evaluated_depsgraph_get()
+    res = export.write_gltf(dg, str(tmp_path / "h.gltf"), width=8, height=8)
+    about = [w for w in res.warnings if "hair" in w]
+    assert len(about) == 1 and "'Furry'" in about[0] and "'Fur'" in about[0], res.warnings
+    assert res.triangles >= 3 * 24 * 10, "the emitters are still exported"
