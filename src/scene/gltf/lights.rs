@@ -39,12 +39,19 @@ impl<'a> Loader<'a> {
         let name = member(self.raw_item("nodes", ni), "name")
             .and_then(Value::as_str)
             .map_or_else(|| format!("node {ni}"), str::to_string);
+        let mut fallbacks = Vec::new();
         let emitted = crate::shading::Graph::from_json(g).ok().and_then(|graph| {
             // Images vary over the light (and are not resolved here).
             if graph.nodes.iter().any(|n| n.props.contains_key("image")) {
                 return None;
             }
             let compiled = crate::shading::compile::compile(&graph, &name).ok()?;
+            // A node the compiler stood in for (an IES texture, say) would fold into a wrong
+            // constant: such a tree keeps the add-on's reading, and says why.
+            if !compiled.warnings.is_empty() {
+                fallbacks = compiled.warnings;
+                return None;
+            }
             compiled.program.constant_set().map(|set| set.emission)
         });
         match (emitted, rgb(t, "base_color")) {
@@ -53,6 +60,9 @@ impl<'a> Loader<'a> {
                 let notes = member(t, "node_warnings").and_then(Value::as_array);
                 for m in notes.into_iter().flatten().filter_map(Value::as_str) {
                     self.warn_once(m.to_string());
+                }
+                for m in fallbacks {
+                    self.warn_once(m);
                 }
                 color
             }

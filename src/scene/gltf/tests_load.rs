@@ -487,9 +487,14 @@ fn a_light_node_graph_is_evaluated_when_constant() {
                                   "node_warnings": ["light 'Lamp': not rendered"] } })
     };
     let noise = json!({"link": [2, "Fac"]});
+    // A node the renderer does not implement must not fold into a constant.
+    let mut unknown = light(json!({"link": [2, "Fac"]}));
+    unknown["TESELA_light"]["graph"]["nodes"][2]["type"] = json!("ShaderNodeTexIES");
+    unknown["TESELA_light"]["node_warnings"] = json!(["light 'Spot': IES not rendered"]);
     let bytes = lights_doc(
         None,
-        json!([{ "extensions": light(json!(2.0)) }, { "extensions": light(noise) }]),
+        json!([{ "extensions": light(json!(2.0)) }, { "extensions": light(noise) },
+               { "extensions": unknown }]),
         json!([]),
     );
     let s = load(&bytes);
@@ -506,6 +511,15 @@ fn a_light_node_graph_is_evaluated_when_constant() {
     // (blue halved) multiply it.
     assert!(warm.x > 2.0 * warm.z && warm.x > 1.0, "{warm}");
     assert!((intensity(1) - Vec3::splat(0.5)).abs().max_element() < 1e-5);
+    assert!((intensity(2) - Vec3::splat(0.5)).abs().max_element() < 1e-5);
+    assert!(
+        warnings.iter().any(|w| w.contains("light 'Spot'")),
+        "{warnings:?}"
+    );
+    assert!(
+        warnings.iter().any(|w| w.contains("ShaderNodeTexIES")),
+        "{warnings:?}"
+    );
     assert_eq!(
         warnings
             .iter()
