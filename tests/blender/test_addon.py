@@ -93,6 +93,10 @@ def simple_scene(width=40, height=30, percentage=100, camera=True):
     scene.view_settings.look = "None"
     scene.view_settings.exposure = 0.0
     scene.view_settings.gamma = 1.0
+    # Start from the panel's defaults: other test files leave their settings on the scene.
+    for prop in scene.tesela.bl_rna.properties:
+        if prop.identifier != "rna_type" and not prop.is_readonly:
+            scene.tesela.property_unset(prop.identifier)
     scene.tesela.samples = 4
     scene.tesela.max_depth = 4
     scene.tesela.use_denoising = False  # the F12-equals-CLI tests compare raw renders
