@@ -182,44 +182,44 @@ unsafe fn node_hits_avx2(node: &CwBvhNode, ray: &BvhRay, oct_inv4: u32) -> u32 {
 /// overlap (traversal of a million triangles is bound by these loads).
 #[inline(always)]
 fn prefetch_hits(bvh: &CwBvh, tris: &[PackedTriangle], node: &CwBvhNode, hits: u32, oct_inv4: u32) {
+    let mut children = hits >> 24;
+    while children != 0 {
+        let slot = children.trailing_zeros() ^ (oct_inv4 & 0xff);
+        let below = (node.imask as u32 & !(u32::MAX << slot)).count_ones();
+        if let Some(child) = bvh.nodes.get((node.child_base_idx + below) as usize) {
+            prefetch(std::slice::from_ref(child));
+        }
+        children &= children - 1;
+    }
+    let leaves = hits & 0x00ff_ffff;
+    if leaves != 0 {
+        let base = node.primitive_base_idx as usize;
+        let first = base + leaves.trailing_zeros() as usize;
+        let last = base + 31 - leaves.leading_zeros() as usize;
+        if let Some(group) = tris.get(first..=last) {
+            prefetch(group);
+        }
+    }
+}
+
+/// Prefetches each cache line `items` spans, once.
+#[inline(always)]
+fn prefetch<T>(items: &[T]) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        let mut children = hits >> 24;
-        while children != 0 {
-            let slot = children.trailing_zeros() ^ (oct_inv4 & 0xff);
-            let below = (node.imask as u32 & !(u32::MAX << slot)).count_ones();
-            let i = (node.child_base_idx + below) as usize;
-            if let Some(child) = bvh.nodes.get(i) {
-                let p = child as *const CwBvhNode as *const i8;
-                // SAFETY: prefetching has no architectural effect; both addresses lie in the
-                // 80-byte node (it may straddle two cache lines).
-                unsafe {
-                    _mm_prefetch::<_MM_HINT_T0>(p);
-                    _mm_prefetch::<_MM_HINT_T0>(p.add(79));
-                }
-            }
-            children &= children - 1;
+        let start = items.as_ptr() as *const i8;
+        let bytes = std::mem::size_of_val(items);
+        if bytes == 0 {
+            return;
         }
-        let leaves = hits & 0x00ff_ffff;
-        if leaves != 0 {
-            let base = node.primitive_base_idx as usize;
-            let first = base + leaves.trailing_zeros() as usize;
-            let last = base + 31 - leaves.leading_zeros() as usize;
-            if last < tris.len() {
-                let (a, b) = (
-                    &tris[first] as *const PackedTriangle as *const i8,
-                    (&tris[last] as *const PackedTriangle as *const i8).wrapping_add(47),
-                );
-                let mut p = a;
-                while p <= b {
-                    // SAFETY: as above; every address lies in `tris[first..=last]`.
-                    unsafe { _mm_prefetch::<_MM_HINT_T0>(p) };
-                    p = p.wrapping_add(64);
-                }
-                // SAFETY: as above.
-                unsafe { _mm_prefetch::<_MM_HINT_T0>(b) };
-            }
+        let last = start.wrapping_add(bytes - 1);
+        // From the start of the first line to the last line, one prefetch per line.
+        let mut p = start.wrapping_sub(start as usize % 64);
+        while p <= last {
+            // SAFETY: prefetching has no architectural effect (an address need not be valid).
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(p) };
+            p = p.wrapping_add(64);
         }
     }
 }
@@ -591,6 +591,16 @@ mod tests {
         [a, b]
     }
 
+    /// A reproducible stream of numbers uniform in `[-1, 1)` (an LCG seeded with `state`).
+    fn uniform(mut state: u64) -> impl FnMut() -> f32 {
+        move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+        }
+    }
+
     fn quad(z: f32) -> Vec<[Vec3; 3]> {
         let a = Vec3::new(-1.0, -1.0, z);
         let b = Vec3::new(1.0, -1.0, z);
@@ -691,13 +701,7 @@ mod tests {
     #[test]
     fn testing_each_triangle_agrees_with_the_bvh() {
         // Eight random triangles, random rays: the same closest hits and occlusion either way.
-        let mut state = 0x853c_49e6_748f_ea9bu64;
-        let mut rnd = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
-        };
+        let mut rnd = uniform(0x853c_49e6_748f_ea9bu64);
         let mut v = move || Vec3::new(rnd(), rnd(), rnd());
         let tris: Vec<[Vec3; 3]> = (0..8).map(|_| [v(), v(), v()]).collect();
         let [small, big] = both(&tris);
@@ -729,13 +733,7 @@ mod tests {
             eprintln!("no AVX2 on this CPU: only the portable traversal runs");
             return;
         }
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
-        };
+        let mut rnd = uniform(0x2545_f491_4f6c_dd1du64);
         let tris: Vec<[Vec3; 3]> = (0..2000)
             .map(|_| {
                 let c = Vec3::new(rnd(), rnd(), rnd()) * 4.0;
@@ -786,13 +784,7 @@ mod tests {
         // Thirty thousand triangles (1.4 MB with the nodes: above the prefetch size) in a
         // cube, rays from inside and outside it: closest and any hits are the same, to the
         // bit, with and without prefetching, for the AVX2 and the portable node test.
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rnd = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
-        };
+        let mut rnd = uniform(0x9e37_79b9_7f4a_7c15u64);
         let tris: Vec<[Vec3; 3]> = (0..30_000)
             .map(|_| {
                 let c = Vec3::new(rnd(), rnd(), rnd()) * 4.0;
