@@ -60,3 +60,26 @@ def finite(v, default=0.0):
 
 def color3(c):
     return [max(0.0, finite(c[0])), max(0.0, finite(c[1])), max(0.0, finite(c[2]))]
+
+
+class TreeReport:
+    """report(owner_name, node, message, kind=None), as MaterialReport, for the node tree of a
+    world or a light (`what`): each problem once, as `world 'NAME': node 'NODE' (TYPE): ...`."""
+
+    def __init__(self, warnings, what):
+        self.warnings, self.what = warnings, what
+        self._seen = set()
+
+    def __call__(self, owner_name, node, message, kind=None):
+        node_name = node if node is None or isinstance(node, str) else node.name
+        key = (owner_name, node_name, kind or message)
+        if key in self._seen:
+            return
+        self._seen.add(key)
+        if node_name is None:
+            text = "%s '%s': %s" % (self.what, owner_name, message)
+        else:
+            idname = getattr(node, "bl_idname", None)
+            text = "%s '%s': node '%s'%s: %s" % (
+                self.what, owner_name, node_name, " (%s)" % idname if idname else "", message)
+        self.warnings.append(text)

@@ -52,7 +52,6 @@ class Geometry:
                         self.texspace)
 
 
-
 def _rendered_hair(obj):
     """Names of the hair particle systems of `obj` that Cycles renders as strands (enabled for
     renders, drawn as paths; object and collection hair arrive as instances)."""
@@ -64,6 +63,7 @@ def _rendered_hair(obj):
         if ps.settings.type == "HAIR" and ps.settings.render_type == "PATH":
             names.append(ps.name)
     return names
+
 
 def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settings=None,
                check_cancel=None, selection=None, mesh_store=None):

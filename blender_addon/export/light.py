@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from .. import compat
-from .common import color3, finite
+from .common import TreeReport, color3, finite
 from .material import GRAPH_VERSION, MaterialGraph
 
 
@@ -21,23 +21,10 @@ def _linked_node(sock):
     return None
 
 
-class _LightReport:
-    """report(light_name, node, message, kind=None) for a light's node tree: each problem once,
-    as `light 'NAME': node 'NODE' (TYPE): ...`."""
-
-    def __init__(self, warnings):
-        self.warnings, self._seen = warnings, set()
-
-    def __call__(self, light_name, node, message, kind=None):
-        node_name = node if node is None or isinstance(node, str) else node.name
-        key = (light_name, node_name, kind or message)
-        if key in self._seen:
-            return
-        self._seen.add(key)
-        idname = getattr(node, "bl_idname", None)
-        where = "" if node_name is None else " node '%s'%s" % (
-            node_name, " (%s)" % idname if idname else "")
-        self.warnings.append("light '%s':%s %s" % (light_name, where, message))
+def _light_output(tree):
+    """The Light Output Cycles uses: the active one, else the first."""
+    outs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputLight"]
+    return next((n for n in outs if n.is_active_output), outs[0] if outs else None)
 
 
 class LightGraph(MaterialGraph):
@@ -50,11 +37,6 @@ class LightGraph(MaterialGraph):
         if out is not None:
             graph["surface"] = self._root(out, "Surface")
         return graph
-
-
-def _light_output(tree):
-    outs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputLight"]
-    return next((n for n in outs if n.is_active_output), outs[0] if outs else None)
 
 
 def node_emission(light, name, warn):
@@ -111,7 +93,7 @@ def convert_light(light, obj, matrix=None, warnings=None, images=None):
     ext = {"type": t, "color": color3(color)}
     if notes and images is not None and light.node_tree is not None:
         graph_warnings = []
-        ext["graph"] = LightGraph(light, images, _LightReport(graph_warnings)).build()
+        ext["graph"] = LightGraph(light, images, TreeReport(graph_warnings, "light")).build()
         ext["base_color"] = color3(base[:3])
         ext["node_warnings"] = notes
         notes = graph_warnings

@@ -10,31 +10,8 @@ viewport colour. Camera visibility and Cycles' importance-sampling settings come
 """
 
 from .. import compat
-from .common import color3, finite
+from .common import TreeReport, color3, finite
 from .material import GRAPH_VERSION, MaterialGraph
-
-
-class WorldReport:
-    """report(world_name, node, message, kind=None), as MaterialReport, for the world: each
-    problem once, as `world 'NAME': node 'NODE' (TYPE): ...`."""
-
-    def __init__(self, warnings):
-        self.warnings = warnings
-        self._seen = set()
-
-    def __call__(self, world_name, node, message, kind=None):
-        node_name = node if node is None or isinstance(node, str) else node.name
-        key = (world_name, node_name, kind or message)
-        if key in self._seen:
-            return
-        self._seen.add(key)
-        if node_name is None:
-            text = "world '%s': %s" % (world_name, message)
-        else:
-            idname = getattr(node, "bl_idname", None)
-            text = "world '%s': node '%s'%s: %s" % (
-                world_name, node_name, " (%s)" % idname if idname else "", message)
-        self.warnings.append(text)
 
 
 def world_output(tree):
@@ -107,7 +84,7 @@ def convert_world(world, warnings, images=None):
                 world_output(tree).inputs.get("Surface")) is None:
             out["color"], out["strength"] = [0.0, 0.0, 0.0], 1.0
     if tree is not None and images is not None:
-        report = WorldReport(warnings)
+        report = TreeReport(warnings, "world")
         saved = images.report  # missing-image messages name the world, not a material
         images.report = report
         try:
