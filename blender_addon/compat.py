@@ -87,6 +87,13 @@ def node_tree(idblock):
     return tree
 
 
+def default_surface_shader():
+    """The shader node Cycles shades objects and slots without a material with, at its
+    defaults (base colour 0.8). Blender 3.x: a Diffuse BSDF; since the Principled v2 rewrite
+    (measured on 5.0): a Principled BSDF, whose highlight material-less objects show."""
+    return "ShaderNodeBsdfPrincipled" if VERSION >= (4, 0, 0) else "ShaderNodeBsdfDiffuse"
+
+
 def material_output(tree):
     """The Material Output node Cycles uses: the active one targeting All or Cycles."""
     getter = getattr(tree, "get_output_node", None)

@@ -23,7 +23,7 @@ from .common import ExportCancelled, color3, finite, gltf_matrix, matrix  # noqa
 from .gltf import ExportResult, border_region, render_size, write_gltf  # noqa: E402,F401
 from .images import ImageTable, Textures, write_png  # noqa: E402,F401
 from .light import convert_light  # noqa: E402,F401
-from .material import (DEFAULT_MATERIAL, MaterialGraph, MaterialReport,  # noqa: E402,F401
+from .material import (MaterialGraph, MaterialReport,  # noqa: E402,F401
                        convert_material, export_material)
 from .mesh import MESHLIKE, mesh_arrays, object_extras, random_id, read_mesh  # noqa: E402,F401
 from .mesh_store import MeshStore  # noqa: E402,F401

@@ -16,7 +16,7 @@ from .common import ExportCancelled, Phases, gltf_matrix, matrix
 from .images import ImageTable, Textures
 from .instances import collapse
 from .light import convert_light
-from .material import DEFAULT_MATERIAL, MaterialReport, export_material
+from .material import MaterialReport, default_surface, export_material
 from .mesh import (MESHLIKE, geometry_key, mesh_arrays, object_extras, read_mesh,
                    undeformed_positions)
 from .world import convert_world
@@ -105,7 +105,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             return material_index[key]
         tangent_uvs = set()
         if mat is None:
-            m = dict(DEFAULT_MATERIAL)
+            m = default_surface()
         else:
             exported = export_material(mat, warnings, textures, images, report)
             m, tangent_uvs = exported.gltf, exported.tangent_uvs

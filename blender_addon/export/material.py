@@ -14,15 +14,23 @@ import bpy
 from .. import compat
 from .common import color3, finite
 
-DEFAULT_MATERIAL = {  # Cycles renders material-less surfaces as 0.8 grey diffuse
-    "name": "__tesela_default",
-    "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1.0],
-                             "metallicFactor": 0.0, "roughnessFactor": 1.0},
-    "doubleSided": True,
-}
-
 GRAPH_VERSION = 1
 RAMP_TABLE_SIZE = 256      # Cycles' RAMP_TABLE_SIZE: tables hold RAMP_TABLE_SIZE + 1 samples
+
+
+def default_surface():
+    """The glTF material for surfaces without a material: Cycles' default shader node, with
+    its metallic-roughness equivalent as the fallback."""
+    node = compat.default_surface_shader()
+    principled = node == "ShaderNodeBsdfPrincipled"
+    graph = {"version": GRAPH_VERSION, "surface": [0, "BSDF"],
+             "nodes": [{"name": "Default Surface", "type": node, "props": {}, "inputs": {},
+                        "internal_links": {}}]}
+    return {"name": "__tesela_default", "doubleSided": True,
+            "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1.0],
+                                     "metallicFactor": 0.0,
+                                     "roughnessFactor": 0.5 if principled else 1.0},
+            "extensions": {"TESELA_material_graph": graph}}
 
 
 # --- the glTF metallic-roughness fallback ------------------------------------------------

@@ -368,6 +368,15 @@ def oren_nayar_ball(kind):
     return build
 
 
+def no_material_ball():
+    """A ball without any material and a floor whose one slot is empty: Cycles shades both
+    with its default surface (a default Principled BSDF since 4.0, highlight included)."""
+    _sphere_stage(None, sun=4.0, sun_dir=(0.3, 0.6, -0.75))
+    floor = bpy.data.objects["Floor"]
+    floor.data.materials.clear()
+    floor.data.materials.append(None)
+
+
 def black_base_ball():
     """A Principled BSDF of base colour exactly black (roughness 0.5) in a bright world: all
     its light is the specular layer's, and the diffuse base below samples directions too."""
@@ -1012,6 +1021,7 @@ CASES = [
     ("oren_nayar_diffuse_ball", oren_nayar_ball("diffuse"), 2, 128, 512),
     ("oren_nayar_principled_ball", oren_nayar_ball("principled"), 2, 128, 512),
     ("principled_black_base", black_base_ball, 2, 128, 512),
+    ("no_material_default_surface", no_material_ball, 2, 128, 512),
     ("named_float_attribute_points", named_attribute("FLOAT", "POINT", "Fac"), 0, 64, 256),
     ("named_float_attribute_faces", named_attribute("FLOAT", "FACE", "Color"), 0, 64, 256),
     ("named_vector_attribute_points", named_attribute("FLOAT_VECTOR", "POINT", "Vector"),
