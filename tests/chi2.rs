@@ -1111,6 +1111,75 @@ fn smooth_plastic_coat_probability() {
     }
 }
 
+/// Cycles' smooth Principled base (`Plastic::cycles`): the coat is picked with probability
+/// `max F`, `F = mix(F0 · tint, 1, (F_exact - F0) / (1 - F0))` per channel, and weighs `F / max F`;
+/// with a white tint `F` is the exact Fresnel reflectance, and a black tint keeps the grazing
+/// reflection (Schlick's F0 scaling would remove it).
+#[test]
+fn smooth_plastic_cycles_coat_probability() {
+    let cases = [
+        (1.5f32, Vec3::ONE),
+        (1.5, Vec3::ZERO),
+        (1.8, Vec3::new(0.0, 0.5, 1.0)),
+        (1.2, Vec3::splat(4.0)),
+    ];
+    let thetas = [0.0, 45.0, 75.0, 88.0];
+    let alpha = sidak(SIGNIFICANCE, cases.len() * thetas.len());
+    let m = 100_000u64;
+    let mut k = 0;
+    for &(eta, tint) in &cases {
+        let b = Plastic::cycles(Vec3::new(0.3, 0.5, 0.7), 0.0, eta, tint);
+        let f0 = ((eta as f64 - 1.0) / (eta as f64 + 1.0)).powi(2);
+        for &theta in &thetas {
+            let wi = dir_at(theta);
+            let s = (fresnel_exact(1.0, eta as f64, wi.z as f64).0 - f0) / (1.0 - f0);
+            let f = tint
+                .as_dvec3()
+                .map(|t| (t * f0).min(1.0))
+                .map(|c| c + (1.0 - c) * s);
+            let share = f.max_element();
+            if tint == Vec3::ZERO && theta == 0.0 {
+                assert!(
+                    share < 1e-6,
+                    "no reflection head-on with a black tint: {share}"
+                );
+            }
+            if tint == Vec3::ONE {
+                let exact = fresnel_exact(1.0, eta as f64, wi.z as f64).0;
+                assert!(
+                    (share - exact).abs() < 1e-5,
+                    "white tint: {share} vs Fresnel {exact}"
+                );
+            }
+            let mut rng = Sampler::new(1200, k, 0);
+            k += 1;
+            let mut coat = 0u64;
+            for _ in 0..m {
+                let mut rec = BsdfQueryRecord::new(wi);
+                let w = b.sample(&mut rec, rng.next_2d(), rng.next_1d());
+                if rec.measure == Measure::Discrete {
+                    coat += 1;
+                    assert_eq!(rec.wo, Vec3::new(-wi.x, -wi.y, wi.z));
+                    let want = f / share;
+                    assert!(
+                        (w.as_dvec3() - want).abs().max_element() < 1e-4,
+                        "coat weight {w} vs F / max F = {want}"
+                    );
+                }
+            }
+            let p = binomial_p_value(coat, m, share);
+            println!(
+                "Cycles smooth Plastic eta={eta} tint={tint} θ={theta}°: coat {coat}/{m}, max F = {share:.5}, p = {p:.4}"
+            );
+            assert!(
+                p >= alpha,
+                "coat fraction {} vs max F {share}: p = {p:.3e}",
+                coat as f64 / m as f64
+            );
+        }
+    }
+}
+
 /// Worst relative difference between an area emitter's triangle choice probability and the
 /// triangle's share of the area, for a UV sphere of `rings × segments`.
 fn worst_triangle_share_error(rings: u32, segments: u32) -> (usize, f64) {

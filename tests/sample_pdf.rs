@@ -139,6 +139,15 @@ fn bsdf_sample_pdf_and_weight_agree() {
             &Plastic::new(c, alpha, ior, spec, color),
         );
     }
+    for (alpha, eta, tint) in [
+        (0.0f32, 1.5f32, Vec3::ZERO),
+        (0.3, 1.45, Vec3::new(1.0, 0.4, 0.0)),
+    ] {
+        run(
+            format!("Cycles Plastic alpha={alpha} eta={eta} tint={tint}"),
+            &Plastic::cycles(c, alpha, eta, tint),
+        );
+    }
 }
 
 /// Like [`check_bsdf`] for lobes that may transmit and may be seen from either side: sampled

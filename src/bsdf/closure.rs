@@ -278,14 +278,13 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
                 let l = RoughConductor::f82(p.base_color, p.specular_tint, ax0, ay0);
                 BaseLobe::RoughConductor(if ms_aniso { l.multiscatter() } else { l }.blurred(blur))
             }
-        } else if p.specular_level * p.specular_tint.max_element() <= 0.0 {
+        } else if !principled_has_specular(p) {
             BaseLobe::Diffuse(rough_diffuse(diffuse))
         } else if ax.max(ay) < DELTA_ALPHA {
-            BaseLobe::Plastic(Plastic::new(
+            BaseLobe::Plastic(Plastic::cycles(
                 diffuse,
                 alpha,
-                p.ior,
-                2.0 * p.specular_level,
+                principled_specular_ior(p.ior, p.specular_level),
                 p.specular_tint,
             ))
         } else {
@@ -324,6 +323,14 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
     }
 }
 
+/// Whether the Principled BSDF's dielectric base has its specular layer: as in Cycles, unless
+/// the level-adjusted IOR is 1 (Specular IOR Level 0, or IOR 1). A black Specular Tint keeps
+/// the layer: it scales `F0` only, and grazing reflection stays white.
+#[inline]
+pub fn principled_has_specular(p: &Principled) -> bool {
+    principled_specular_ior(p.ior, p.specular_level) != 1.0
+}
+
 /// `A(wi)`: the share of light arriving from the local direction `wi` (above the closure's
 /// normal) that the Principled BSDF's layers above its dielectric base — specular, coat and
 /// sheen — pass down to it, per channel: the factor on the subsurface closure, as Cycles'
@@ -334,7 +341,7 @@ pub fn principled_base_attenuation(p: &Principled, wi: Vec3) -> Vec3 {
     let r = p.roughness.clamp(0.0, 1.0);
     let (ax, ay) = anisotropy::principled(r, p.anisotropic);
     let mut att = Vec3::ONE;
-    if p.specular_level * p.specular_tint.max_element() > 0.0 {
+    if principled_has_specular(p) {
         let ior = principled_specular_ior(p.ior, p.specular_level);
         let (ax, ay) = (ax.max(DELTA_ALPHA), ay.max(DELTA_ALPHA));
         let specular = RoughDielectric::principled_specular(p.specular_tint, ior, ax, ay);

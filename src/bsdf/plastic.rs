@@ -1,9 +1,10 @@
-//! The dielectric base of glTF's metallic-roughness model: a specular coat (GGX, or a smooth
+//! The dielectric base of a Principled-style material: a specular coat (GGX, or a smooth
 //! delta coat when alpha is tiny) over a Lambertian base.
 //!
-//! `f = s(wi) f_coat + (1 - s(wi)) base/π`, with the coat's share `s(wi) = specular ·
-//! Schlick(F0, cos θi)`, `F0 = ((η-1)/(η+1))² · max(specular colour)` (KHR_materials_specular).
-//! Sampling picks the coat with probability `s(wi)`; `pdf` is the matching mixture density.
+//! `f = F(wi) f_coat + (1 - max F(wi)) base/π`, with the coat's reflectance `F(wi)` per channel
+//! from [`CoatFresnel`]: glTF's `specular · Schlick(F0, cos θi) · tint`, or Cycles' generalized
+//! Schlick over the real dielectric Fresnel (its smooth Principled BSDF). Sampling picks the
+//! coat with probability `max F(wi)`; `pdf` is the matching mixture density.
 
 use super::microfacet::{ggx_d, ggx_g2, reflection_pdf, sample_reflection};
 use super::{Bsdf, BsdfQueryRecord, DELTA_ALPHA, Measure, fresnel};
@@ -15,13 +16,23 @@ use std::f32::consts::FRAC_1_PI;
 pub struct Plastic {
     pub base: Vec3,
     pub alpha: f32,
-    pub f0: f32,
-    pub specular: f32,
-    /// Coat tint (specular colour normalised to a maximum of 1).
-    pub coat_tint: Vec3,
+    pub fresnel: CoatFresnel,
+}
+
+/// The coat's reflectance `F(cos θi)`, per channel, `cos θi` against the shading normal.
+#[derive(Clone, Copy, Debug)]
+pub enum CoatFresnel {
+    /// glTF's metallic-roughness with KHR_materials_specular: `specular · Schlick(F0, cos)`
+    /// tinted by the specular colour normalised to a maximum of 1, `F0 = F0(η) · max(colour)`.
+    Schlick { f0: f32, specular: f32, tint: Vec3 },
+    /// Cycles' Principled specular layer: `mix(F0 · tint, 1, s)`, `s = (F(cos, η) - F0) /
+    /// (1 - F0)` with `F` the exact dielectric reflectance and `F0 = F0(η)`; a black tint keeps
+    /// the white grazing reflection.
+    Cycles { eta: f32, f0: f32, f0_tint: Vec3 },
 }
 
 impl Plastic {
+    /// glTF's model ([`CoatFresnel::Schlick`]).
     pub fn new(base: Vec3, alpha: f32, ior: f32, specular: f32, specular_color: Vec3) -> Self {
         let m = specular_color.max_element();
         let (f0, tint) = if m > 0.0 {
@@ -32,15 +43,52 @@ impl Plastic {
         Plastic {
             base,
             alpha,
-            f0,
-            specular: specular.clamp(0.0, 1.0),
-            coat_tint: tint,
+            fresnel: CoatFresnel::Schlick {
+                f0,
+                specular: specular.clamp(0.0, 1.0),
+                tint,
+            },
         }
     }
 
+    /// Cycles' Principled BSDF dielectric base ([`CoatFresnel::Cycles`]); `eta` is the
+    /// level-adjusted IOR ([`super::rough_dielectric::principled_specular_ior`]).
+    pub fn cycles(base: Vec3, alpha: f32, eta: f32, specular_tint: Vec3) -> Self {
+        let f0 = fresnel::f0_from_ior(eta);
+        Plastic {
+            base,
+            alpha,
+            fresnel: CoatFresnel::Cycles {
+                eta,
+                f0,
+                f0_tint: (specular_tint.max(Vec3::ZERO) * f0).min(Vec3::ONE),
+            },
+        }
+    }
+
+    /// The coat's reflectance `F(cos θi)` per channel.
     #[inline]
-    pub(crate) fn coat_share(&self, cos_i: f32) -> f32 {
-        self.specular * fresnel::schlick1(self.f0, cos_i)
+    pub fn coat_fresnel(&self, cos_i: f32) -> Vec3 {
+        match self.fresnel {
+            CoatFresnel::Schlick { f0, specular, tint } => {
+                specular * fresnel::schlick1(f0, cos_i) * tint
+            }
+            CoatFresnel::Cycles { eta, f0, f0_tint } => {
+                let s = if f0 < 1.0 {
+                    ((fresnel::dielectric(cos_i.clamp(0.0, 1.0), eta).0 - f0) / (1.0 - f0))
+                        .clamp(0.0, 1.0)
+                } else {
+                    1.0
+                };
+                f0_tint + (Vec3::ONE - f0_tint) * s
+            }
+        }
+    }
+
+    /// The probability of sampling the coat, `max F(cos θi)`; the base keeps `1 -` this.
+    #[inline]
+    pub fn coat_share(&self, cos_i: f32) -> f32 {
+        self.coat_fresnel(cos_i).max_element().min(1.0)
     }
 
     #[inline]
@@ -57,14 +105,13 @@ impl Plastic {
         if wi.z <= 0.0 || wo.z <= 0.0 {
             return (Vec3::ZERO, Vec3::ZERO);
         }
-        let s = self.coat_share(wi.z);
-        let base = (1.0 - s) * self.base * FRAC_1_PI;
+        let f = self.coat_fresnel(wi.z);
+        let base = (1.0 - f.max_element().min(1.0)) * self.base * FRAC_1_PI;
         if self.smooth() {
             return (base, Vec3::ZERO);
         }
         let h = (wi + wo).normalize();
-        let coat = s * self.coat_tint * ggx_d(h, self.alpha) * ggx_g2(wi, wo, self.alpha)
-            / (4.0 * wi.z * wo.z);
+        let coat = f * ggx_d(h, self.alpha) * ggx_g2(wi, wo, self.alpha) / (4.0 * wi.z * wo.z);
         (base, coat)
     }
 }
@@ -75,13 +122,14 @@ impl Bsdf for Plastic {
         if wi.z <= 0.0 {
             return Vec3::ZERO;
         }
-        let s = self.coat_share(wi.z);
+        let f = self.coat_fresnel(wi.z);
+        let s = f.max_element().min(1.0);
         rec.eta = 1.0;
         if self.smooth() && u1 < s {
             rec.wo = Vec3::new(-wi.x, -wi.y, wi.z);
             rec.measure = Measure::Discrete;
             rec.pdf = 0.0;
-            return self.coat_tint;
+            return f / s;
         }
         rec.measure = Measure::SolidAngle;
         if self.smooth() {

@@ -3,8 +3,10 @@
 //! over its `bsdf_albedo` estimates.
 
 use super::LightClass;
+use crate::bsdf::closure::principled_has_specular;
 use crate::bsdf::fresnel;
 use crate::bsdf::layered::{Coat, Layer};
+use crate::bsdf::rough_dielectric::principled_specular_ior;
 use crate::bsdf::tables::reflection_fresnel_s;
 use crate::bsdf::{Plastic, Sheen};
 use crate::shading::{Closure, ClosureKind, Principled};
@@ -91,19 +93,28 @@ fn principled_colors(p: &Principled, mu: f32, backfacing: bool) -> [Vec3; 3] {
     // Metals' F82 colour: the base colour at normal incidence.
     glossy += att * metal * p.base_color;
     if base > 0.0 {
-        let pl = Plastic::new(
-            p.base_color,
-            r * r,
-            p.ior,
-            2.0 * p.specular_level,
-            p.specular_tint,
-        );
-        let s = if p.specular_level * p.specular_tint.max_element() > 0.0 {
-            pl.coat_share(mu)
+        let pl = if p.cycles {
+            Plastic::cycles(
+                p.base_color,
+                r * r,
+                principled_specular_ior(p.ior, p.specular_level),
+                p.specular_tint,
+            )
         } else {
-            0.0
+            Plastic::new(
+                p.base_color,
+                r * r,
+                p.ior,
+                2.0 * p.specular_level,
+                p.specular_tint,
+            )
         };
-        glossy += att * base * s * pl.coat_tint;
+        let (f, s) = if principled_has_specular(p) {
+            (pl.coat_fresnel(mu), pl.coat_share(mu))
+        } else {
+            (Vec3::ZERO, 0.0)
+        };
+        glossy += att * base * f;
         diffuse += att * base * (1.0 - s) * p.base_color;
     }
     [diffuse, glossy, transmission]

@@ -368,6 +368,16 @@ def oren_nayar_ball(kind):
     return build
 
 
+def smooth_principled_ball():
+    """A Principled BSDF at roughness 0 (a delta specular layer over its diffuse base) with a
+    Specular Tint of (0, 0.5, 1) in a bright world: Cycles' generalized Schlick Fresnel, exact
+    dielectric reflectance shaped, tints only F0, so the red channel keeps its white rim."""
+    mat, nt, out = node_material("SmoothTinted")
+    principled(nt, out, Base_Color=(0.1, 0.15, 0.3, 1.0), Roughness=0.0,
+               Specular_Tint=(0.0, 0.5, 1.0, 1.0))
+    _sphere_stage(mat, world_strength=1.0, sun=2.0)
+
+
 def no_material_ball():
     """A ball without any material and a floor whose one slot is empty: Cycles shades both
     with its default surface (a default Principled BSDF since 4.0, highlight included)."""
@@ -1022,6 +1032,7 @@ CASES = [
     ("oren_nayar_principled_ball", oren_nayar_ball("principled"), 2, 128, 512),
     ("principled_black_base", black_base_ball, 2, 128, 512),
     ("no_material_default_surface", no_material_ball, 2, 128, 512),
+    ("principled_smooth_tinted", smooth_principled_ball, 2, 128, 512),
     ("named_float_attribute_points", named_attribute("FLOAT", "POINT", "Fac"), 0, 64, 256),
     ("named_float_attribute_faces", named_attribute("FLOAT", "FACE", "Color"), 0, 64, 256),
     ("named_vector_attribute_points", named_attribute("FLOAT_VECTOR", "POINT", "Vector"),
