@@ -40,6 +40,63 @@ def _read_from_file(image):
             and not getattr(image, "packed_file", None))
 
 
+def _tile_path(pattern, number):
+    """A UDIM tile's file from the image's path pattern (``<UDIM>``: 1001..., ``<UVTILE>``:
+    u1_v1...)."""
+    u, v = (number - 1001) % 10 + 1, (number - 1001) // 10 + 1
+    return pattern.replace("<UDIM>", str(number)).replace("<UVTILE>", "u%d_v%d" % (u, v))
+
+
+def _tile_files(image):
+    """(tile number, file bytes or None, path, packed) of each tile of a UDIM image: packed
+    data when the image is packed, else the file on disk."""
+    import bpy
+    pattern = bpy.path.abspath(image.filepath_raw or image.filepath, library=image.library)
+    packed = {}
+    for pf in getattr(image, "packed_files", None) or ():
+        if getattr(pf, "packed_file", None) is not None:
+            packed[int(getattr(pf, "tile_number", 1001))] = pf.packed_file
+    out = []
+    for tile in image.tiles:
+        number = int(tile.number)
+        path = os.path.normpath(_tile_path(pattern, number))
+        data = None
+        if number in packed:
+            data = bytes(packed[number].data)
+            out.append((number, data, path, True))
+            continue
+        elif os.path.isfile(path):
+            try:
+                with open(path, "rb") as f:
+                    data = f.read()
+            except OSError:
+                data = None
+        out.append((number, data, path, False))
+    return out
+
+
+def _tile_is_float(data):
+    """Whether the renderer decodes the file to floats: more than 8 bits per PNG sample
+    (the IHDR's bit depth), OpenEXR, Radiance HDR."""
+    fmt = _tile_format(data)
+    if fmt == "png":
+        return len(data) > 24 and data[24] > 8
+    return fmt in ("exr", "hdr")
+
+
+def _tile_format(data):
+    """The file format the renderer decodes, from the file's signature, or None."""
+    if data.startswith(b"\x89PNG\r\n\x1a\n"):
+        return "png"
+    if data.startswith(b"\xff\xd8\xff"):
+        return "jpeg"
+    if data.startswith(b"\x76\x2f\x31\x01"):
+        return "exr"
+    if data.startswith((b"#?RADIANCE", b"#?RGBE")):
+        return "hdr"
+    return None
+
+
 class Textures:
     """Images, samplers and textures of one export; images are PNG files beside the .gltf."""
 
@@ -142,8 +199,8 @@ class ImageTable:
             self.report(material_name, node, "image '%s' is a %s: the frame Blender has loaded is "
                         "used, which may not be the current frame" % (image.name, source.lower()))
         elif source == "TILED":
-            self.report(material_name, node, "image '%s' has UDIM tiles: only the first tile is "
-                        "exported" % image.name)
+            self.report(material_name, node, "image '%s' has no UDIM tile file Tesela can read: "
+                        "only Blender's first tile is rendered" % image.name)
         key = (getattr(image, "name_full", image.name), frame)
         if key in self._index:
             idx = self._index[key]
@@ -199,6 +256,48 @@ class ImageTable:
         self.images.append(entry)
         self._index[key] = len(self.images) - 1
         return self._index[key]
+
+    def add_tiles(self, image, node, material_name):
+        """``[[tile number, TESELA_images index], ...]`` of a UDIM image whose every tile file
+        can be read (from disk, or packed), or None (``add`` then gives the first tile from
+        Blender's pixels, which hold that tile only). The files travel whole, for the
+        renderer to decode as Cycles' loader does."""
+        key = (getattr(image, "name_full", image.name), "tiles")
+        if key in self._index:
+            return self._index[key]
+        tiles = []
+        for number, data, path, packed in _tile_files(image):
+            if data is None:
+                # As in Cycles, a tile without its file renders as a missing image.
+                self.report(material_name, node, "image '%s': UDIM tile %d has no file at '%s'; "
+                            "it renders as a missing image" % (image.name, number, path))
+            elif _tile_format(data) is None:
+                self.report(material_name, node, "image '%s': UDIM tile %d ('%s') is not PNG, "
+                            "JPEG, OpenEXR or Radiance HDR; it renders as a missing image"
+                            % (image.name, number, os.path.basename(path)))
+            else:
+                tiles.append((number, data, path, packed))
+        if not tiles:
+            self._index[key] = None
+            return None
+        cs = image.colorspace_settings.name
+        alpha_mode = getattr(image, "alpha_mode", "STRAIGHT")
+        out = []
+        for number, data, path, packed in tiles:
+            # Cycles reads files itself, keeping sRGB floats encoded (as `add`); packed tiles
+            # come from Blender's buffers, float ones linear.
+            linearize = packed and _tile_is_float(data) and cs == "sRGB"
+            entry = {"name": "%s.%d" % (image.name, number), "encoded": True,
+                     "file": os.path.basename(path), "bufferView": self.buffer.add_view(data),
+                     "colorspace": "Non-Color" if linearize else cs, "source_colorspace": cs,
+                     "alpha_mode": alpha_mode, "linearize": linearize,
+                     # Straight-alpha float files (16-bit PNG) are associated on load.
+                     "premultiply": alpha_mode not in ("CHANNEL_PACKED", "NONE")
+                     and cs not in ("Non-Color", "Raw", "Generic Data")}
+            self.images.append(entry)
+            out.append([number, len(self.images) - 1])
+        self._index[key] = out
+        return out
 
     def _missing(self, image, node, material_name):
         self.report(material_name, node, "image '%s' has no pixels (missing file?); it renders "

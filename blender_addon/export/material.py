@@ -501,7 +501,14 @@ class MaterialGraph:
         image = getattr(node, "image", None)
         if image is None:
             return
-        idx = self.images.add(image, node, self.name)
+        tiles = None
+        if getattr(image, "source", "FILE") == "TILED" and node.bl_idname == "ShaderNodeTexImage":
+            tiles = self.images.add_tiles(image, node, self.name)
+        if tiles:
+            props["tiles"] = tiles
+            idx = tiles[0][1]
+        else:
+            idx = self.images.add(image, node, self.name)
         props["image"] = idx
         if idx is not None:  # how the pixels as written are to be read (see TESELA_images)
             entry = self.images.images[idx]

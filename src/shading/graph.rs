@@ -26,6 +26,8 @@ pub struct Node {
     pub internal_links: Vec<(String, String)>,
     /// For image nodes: the index into the scene's images (resolved by the loader).
     pub image: Option<usize>,
+    /// For UDIM image nodes: `(tile number, scene image)` of each tile (`tiles` prop).
+    pub tiles: Vec<(u32, usize)>,
 }
 
 impl Node {
@@ -156,6 +158,7 @@ impl Graph {
                 inputs,
                 internal_links,
                 image: None,
+                tiles: Vec::new(),
             });
         }
         let output = |key: &str| -> Result<Option<(usize, String)>, String> {

@@ -6,7 +6,8 @@ comes from Blender's buffers, float ones already linear. A magnified, high-contr
 shows the difference: interpolating encoded values darkens the blends between texels (42%
 darker on the 16-bit checker below, 2% on a bright blob in an HDR world). Cases: a 16-bit PNG
 colour texture (the common export of texture painters) from its file and packed, an EXR tagged
-sRGB, an 8-bit PNG, and an sRGB EXR world seen directly and lighting a floor.
+sRGB, an 8-bit PNG, an sRGB EXR world seen directly and lighting a floor, and UDIM images
+(8- and 16-bit PNG tiles, EXR tiles, packed tiles), whose tiles past the first only the files hold.
 
 Criteria as tests/blender/test_lights_cycles.py: means within 2%, 8x8 blocks within 5% at the
 95th percentile, edges locally.
@@ -118,6 +119,58 @@ def hdr_world(tmp_path, floor):
     return scenes.SceneInfo(bpy.context.scene, "hdr_world")
 
 
+def _write_tile(path, px, kind):
+    """A UDIM tile file: ``png8`` (through Blender), ``png16`` or ``exr``."""
+    if kind == "png16":
+        write_png(str(path), px)
+        return
+    img = bpy.data.images.new("tile", px.shape[1], px.shape[0], alpha=True,
+                              float_buffer=kind == "exr")
+    img.colorspace_settings.name = "Non-Color"  # store the values as given
+    img.pixels.foreach_set(px[::-1].ravel())
+    img.filepath_raw = str(path)
+    img.file_format = "OPEN_EXR" if kind == "exr" else "PNG"
+    img.save()
+    bpy.data.images.remove(img)
+
+
+def udim_plane(tmp_path, kinds, pack=False):
+    """An emissive 10x10-face grid whose UVs span [0, 2]^2: four UDIM tiles 1001, 1002, 1011
+    and 1012, of which the image has the first three (files of ``kinds``, each a differently
+    tinted magnified checker; the fourth renders Cycles' missing-image magenta). Each face lies
+    in one tile, so Cycles keeps every tile (it culls tiles no triangle's centroid is in)."""
+    scenes.clear_scene()
+    numbers = (1001, 1002, 1011)
+    for number, kind, tint in zip(numbers, kinds, ((1, 1, 1), (0.3, 1, 0.6), (0.5, 0.6, 1))):
+        px = _checker()
+        px[..., :3] *= np.array(tint, np.float32)
+        ext = "exr" if kind == "exr" else "png"
+        _write_tile(tmp_path / ("skin.%d.%s" % (number, ext)), px, kind)
+    ext = "exr" if kinds[0] == "exr" else "png"
+    img = bpy.data.images.load(str(tmp_path / ("skin.1001.%s" % ext)), check_existing=False)
+    img.source = "TILED"
+    img.colorspace_settings.name = "sRGB"
+    assert [t.number for t in img.tiles] == list(numbers), "Blender finds the tiles"
+    if pack:
+        img.pack()
+    mat = bpy.data.materials.new("Skin")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.remove(nt.nodes["Principled BSDF"])
+    tex = nt.nodes.new("ShaderNodeTexImage")
+    tex.image, tex.interpolation = img, "Linear"
+    em = nt.nodes.new("ShaderNodeEmission")
+    nt.links.new(tex.outputs["Color"], em.inputs["Color"])
+    nt.links.new(em.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=11, y_subdivisions=11, size=2.0)
+    grid = bpy.context.active_object
+    grid.data.materials.append(mat)
+    for loop_uv in grid.data.uv_layers.active.data:
+        loop_uv.uv = (loop_uv.uv[0] * 2.0, loop_uv.uv[1] * 2.0)
+    scenes.add_camera((0.0, 0.0, 2.2), (0.0, 0.0, 0.0), fov=math.radians(50.0))
+    return scenes.SceneInfo(bpy.context.scene, "udim_plane")
+
+
 # (id, builder taking tmp_path, Cycles max_bounces, Tesela integrator, spp)
 CASES = [
     ("png16_file", lambda t: textured_plane(t, "checker.png"), 0, "direct_mis", 16),
@@ -126,6 +179,11 @@ CASES = [
     ("png8_file", lambda t: textured_plane(t, "checker8.png"), 0, "direct_mis", 16),
     ("srgb_exr_world_seen", lambda t: hdr_world(t, floor=False), 0, "direct_mis", 16),
     ("srgb_exr_world_lights_a_floor", lambda t: hdr_world(t, floor=True), 1, "path_mis", 256),
+    ("udim_png8_png16_files", lambda t: udim_plane(t, ("png8", "png16", "png8")), 0,
+     "direct_mis", 16),
+    ("udim_exr_files", lambda t: udim_plane(t, ("exr",) * 3), 0, "direct_mis", 16),
+    ("udim_png16_packed", lambda t: udim_plane(t, ("png16",) * 3, pack=True), 0,
+     "direct_mis", 16),
 ]
 
 

@@ -553,8 +553,7 @@ impl<'a> Loader<'a> {
             let Some(ii) = node.props.get("image").and_then(Value::as_u64) else {
                 continue;
             };
-            let ii = ii as usize;
-            let image = self.graph_image(ii).map_err(|e| {
+            let in_node = |e: LoadError| {
                 LoadError::new(
                     e.kind,
                     format!(
@@ -562,8 +561,27 @@ impl<'a> Loader<'a> {
                         node.name, e.message
                     ),
                 )
-            })?;
-            node.image = Some(image);
+            };
+            node.image = Some(self.graph_image(ii as usize).map_err(in_node)?);
+            if let Some(tiles) = node.props.get("tiles") {
+                let mut resolved = Vec::new();
+                for t in tiles.as_array().into_iter().flatten() {
+                    let pair = t.as_array().map(Vec::as_slice);
+                    let Some([number, image]) = pair else {
+                        return Err(in_node(invalid(
+                            "`tiles` entries must be [tile number, image]".into(),
+                        )));
+                    };
+                    let (Some(number), Some(image)) = (number.as_u64(), image.as_u64()) else {
+                        return Err(in_node(invalid(
+                            "`tiles` entries must be [tile number, image]".into(),
+                        )));
+                    };
+                    let image = self.graph_image(image as usize).map_err(in_node)?;
+                    resolved.push((number.min(u32::MAX as u64) as u32, image));
+                }
+                node.tiles = resolved;
+            }
         }
         Ok(graph)
     }
@@ -597,6 +615,9 @@ impl<'a> Loader<'a> {
     /// Decodes one `TESELA_images` entry: raw pixel rows, top to bottom, in a bufferView.
     fn raw_image(&mut self, e: &Value, ii: usize) -> Result<Image, LoadError> {
         let label = format!("TESELA_images image {ii}");
+        if member(e, "encoded").and_then(Value::as_bool) == Some(true) {
+            return self.encoded_image(e, &label);
+        }
         let dim = |k: &str| -> Result<u32, LoadError> {
             member(e, k)
                 .and_then(Value::as_u64)
@@ -688,6 +709,27 @@ impl<'a> Loader<'a> {
             height: h,
             rgba8,
             float,
+        })
+    }
+
+    /// A `TESELA_images` entry holding a whole image file in its bufferView
+    /// ([`super::image_file`]); `linearize` asks for float texels to be decoded from sRGB,
+    /// `premultiply` for straight float alpha to be associated.
+    fn encoded_image(&mut self, e: &Value, label: &str) -> Result<Image, LoadError> {
+        let vi = member(e, "bufferView")
+            .and_then(Value::as_u64)
+            .ok_or_else(|| invalid(format!("{label}: no `bufferView`")))? as usize;
+        let (bytes, _) = self
+            .reader
+            .view(vi, label)
+            .map_err(|err| LoadError::new(err.kind, format!("{label}: {}", err.message)))?;
+        let associate = member(e, "premultiply").and_then(Value::as_bool) == Some(true);
+        let linearize = member(e, "linearize").and_then(Value::as_bool) == Some(true);
+        let file = member(e, "file").and_then(Value::as_str).unwrap_or("");
+        super::image_file::decode(bytes, associate, linearize).map_err(|err| {
+            invalid(format!(
+                "{label} (`{file}`): cannot decode the image: {err}"
+            ))
         })
     }
 

@@ -15,6 +15,7 @@ mod accessor;
 mod camera;
 mod container;
 mod document;
+mod image_file;
 mod instances;
 mod lights;
 mod material;

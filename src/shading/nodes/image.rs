@@ -17,8 +17,10 @@ use glam::{Vec2, Vec3, Vec4};
 
 #[derive(Clone, Debug)]
 pub struct ImageOp {
-    /// Index into the scene's images.
+    /// Index into the scene's images (a UDIM image's first tile).
     image: usize,
+    /// A UDIM image's tiles, `(tile number, scene image)`; empty for a single image.
+    tiles: Box<[(u32, usize)]>,
     /// Lookup parameters (wrap, filter), as for a glTF texture.
     sampler: Texture,
     /// Blender's CLIP extension: transparent black outside `[0, 1]²`.
@@ -129,9 +131,10 @@ impl ImageOp {
         };
         let co = s.v(self.vector);
         let c = match self.projection {
-            Projection::Flat => self.at(img, Vec2::new(co.x, co.y)),
-            Projection::Sphere => self.at(img, map_to_sphere((co - 0.5) * 2.0)),
-            Projection::Tube => self.at(img, map_to_tube((co - 0.5) * 2.0)),
+            Projection::Flat => self.at_tile(img, env, Vec2::new(co.x, co.y)),
+            Projection::Sphere => self.at_tile(img, env, map_to_sphere((co - 0.5) * 2.0)),
+            Projection::Tube => self.at_tile(img, env, map_to_tube((co - 0.5) * 2.0)),
+            // As in Cycles, box projection reads the first tile only.
             Projection::Box { blend } => {
                 let n = g.normal_to_object(g.n);
                 let w = box_weights(n, blend);
@@ -154,6 +157,28 @@ impl ImageOp {
         };
         s.set_v(self.color, c.truncate());
         s.set_f(self.alpha, c.w);
+    }
+
+    /// [`ImageOp::at`] in the UDIM tile `uv` falls in (Cycles' `svm_node_tex_image`): tile
+    /// `1001 + 10 ty + tx` for `(tx, ty)` the coordinates truncated toward zero, `0 ≤ tx < 10`,
+    /// `ty ≥ 0`, read at `uv - (tx, ty)`; outside every tile, Cycles' missing-image magenta.
+    #[inline]
+    fn at_tile(&self, img: &Image, env: &ShadeEnv, uv: Vec2) -> Vec4 {
+        if self.tiles.is_empty() {
+            return self.at(img, uv);
+        }
+        let (tx, ty) = (uv.x as i32, uv.y as i32);
+        if (0..10).contains(&tx) && ty >= 0 {
+            let tile = (ty as u32)
+                .saturating_mul(10)
+                .saturating_add(1001 + tx as u32);
+            if let Some(&(_, i)) = self.tiles.iter().find(|t| t.0 == tile)
+                && let Some(img) = env.images.get(i)
+            {
+                return self.at(img, uv - Vec2::new(tx as f32, ty as f32));
+            }
+        }
+        Vec4::new(1.0, 0.0, 1.0, 1.0)
     }
 
     /// One lookup at image coordinates `uv` (Blender's, or glTF's for glTF graphs): linear
@@ -314,6 +339,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
     cx.emit(
         Op::Image(ImageOp {
             image,
+            tiles: cx.node().tiles.clone().into_boxed_slice(),
             sampler: Texture {
                 image,
                 wrap_s,
