@@ -132,6 +132,70 @@ def undeformed_positions(obj, co, render=True):
     return None if np.array_equal(out, co) else out
 
 
+# The face attribute carrying each face's island (Geometry > Random Per Island).
+ISLAND_ATTRIBUTE = ".tesela.island"
+
+
+def _tree_uses_random_per_island(tree, seen):
+    if tree is None or tree.name in seen:
+        return False
+    seen.add(tree.name)
+    for node in tree.nodes:
+        if node.bl_idname == "ShaderNodeNewGeometry":
+            out = node.outputs.get("Random Per Island")
+            if out is not None and out.is_linked:
+                return True
+        elif getattr(node, "node_tree", None) is not None:
+            if _tree_uses_random_per_island(node.node_tree, seen):
+                return True
+    return False
+
+
+def _uses_random_per_island(mesh):
+    """Whether a material of the mesh reads Geometry > Random Per Island."""
+    seen = set()
+    return any(m is not None and _tree_uses_random_per_island(compat.node_tree(m), seen)
+               for m in mesh.materials)
+
+
+def _island_ids(mesh, raw, n_verts):
+    """Per face, its island as Cycles numbers it: the representative vertex of the face's
+    connected component, from joining every edge's vertices in the mesh's edge order with
+    union by rank (Cycles' DisjointSet; the renderer hashes the index). (n_faces, 4) float32
+    holding the index's low and high 16 bits, exact for any vertex count."""
+    n_edges = len(mesh.edges)
+    edges = np.empty(n_edges * 2, dtype=np.int64)
+    if n_edges:
+        mesh.edges.foreach_get("vertices", edges)
+    parent = list(range(n_verts))
+    rank = [0] * n_verts
+
+    def find(x):
+        root = x
+        while parent[root] != root:
+            root = parent[root]
+        while parent[x] != root:
+            parent[x], x = root, parent[x]
+        return root
+
+    for a, b in edges.reshape(-1, 2).tolist():
+        ra, rb = find(a), find(b)
+        if ra == rb:
+            continue
+        if rank[ra] < rank[rb]:
+            ra, rb = rb, ra
+        parent[rb] = ra
+        if rank[ra] == rank[rb]:
+            rank[ra] += 1
+    first = raw.loop_vert[raw.loop_start].tolist()
+    roots = np.array([find(v) for v in first], dtype=np.int64)
+    out = np.zeros((len(first), 4), dtype=np.float32)
+    out[:, 0] = roots & 0xFFFF
+    out[:, 1] = roots >> 16
+    out[:, 3] = 1.0
+    return out
+
+
 def read_mesh(mesh, check_cancel=None, phases=None):
     """The RawMesh of an evaluated mesh, or None if it has no faces; phases: a Phases adding up
     the seconds of each step."""
@@ -172,6 +236,8 @@ def read_mesh(mesh, check_cancel=None, phases=None):
         skip = {name for name, _, _ in raw.colors} | {name for name, _ in raw.uvs}
         raw.colors += [(name, values, domain) for name, domain, values
                        in compat.generic_attributes(mesh, counts, skip)]
+        if _uses_random_per_island(mesh):
+            raw.colors.append((ISLAND_ATTRIBUTE, _island_ids(mesh, raw, n_verts), "FACE"))
         if any(domain == "FACE" for _, _, domain in raw.colors):
             # Each corner takes its face's value (faces' corners are consecutive).
             face_corners = np.diff(np.append(raw.loop_start, n_loops))

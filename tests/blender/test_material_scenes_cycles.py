@@ -368,6 +368,23 @@ def oren_nayar_ball(kind):
     return build
 
 
+def random_per_island():
+    """Thirty cubes in one mesh (two Array modifiers, nothing merged), each an island, shown
+    by White Noise of Geometry > Random Per Island: every island's colour depends on the exact
+    value Cycles derives from the island's representative vertex."""
+    bpy.ops.mesh.primitive_cube_add(size=0.3, location=(-1.0, -0.8, 0.0))
+    cubes = bpy.context.active_object
+    for name, count, offset in (("Row", 6, (1.3, 0, 0)), ("Column", 5, (0, 1.3, 0))):
+        arr = cubes.modifiers.new(name, "ARRAY")
+        arr.count, arr.relative_offset_displace = count, offset
+    mat, nt, out = node_material("Islands")
+    white = node(nt, "ShaderNodeTexWhiteNoise", {"noise_dimensions": "1D"},
+                 W=node(nt, "ShaderNodeNewGeometry").outputs["Random Per Island"])
+    surface(nt, out, node(nt, "ShaderNodeEmission", Color=white.outputs["Color"]).outputs[0])
+    cubes.data.materials.append(mat)
+    scenes.add_camera((0.0, 0.0, 4.0), (0.0, 0.0, 0.0), fov=math.radians(50.0))
+
+
 def smooth_principled_ball():
     """A Principled BSDF at roughness 0 (a delta specular layer over its diffuse base) with a
     Specular Tint of (0, 0.5, 1) in a bright world: Cycles' generalized Schlick Fresnel, exact
@@ -1033,6 +1050,7 @@ CASES = [
     ("principled_black_base", black_base_ball, 2, 128, 512),
     ("no_material_default_surface", no_material_ball, 2, 128, 512),
     ("principled_smooth_tinted", smooth_principled_ball, 2, 128, 512),
+    ("random_per_island", random_per_island, 0, 64, 256),
     ("named_float_attribute_points", named_attribute("FLOAT", "POINT", "Fac"), 0, 64, 256),
     ("named_float_attribute_faces", named_attribute("FLOAT", "FACE", "Color"), 0, 64, 256),
     ("named_vector_attribute_points", named_attribute("FLOAT_VECTOR", "POINT", "Vector"),

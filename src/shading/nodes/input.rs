@@ -44,6 +44,8 @@ pub enum Source {
     Color(String, bool),
     /// A geometry attribute by name: a UV map (Blender convention) or a colour attribute.
     Attribute(String, AttrPart),
+    /// Geometry > Random Per Island, from the face attribute [`ISLAND_ATTRIBUTE`].
+    RandomPerIsland,
     /// Layer Weight (`fresnel` output or `facing`), blend slot, optional normal slot.
     LayerWeight {
         fresnel: bool,
@@ -58,6 +60,9 @@ pub enum Source {
 }
 
 /// Which part of an attribute the Attribute node's output carries.
+/// The face attribute the add-on writes each face's island into (Random Per Island).
+pub const ISLAND_ATTRIBUTE: &str = ".tesela.island";
+
 #[derive(Clone, Copy, Debug)]
 pub enum AttrPart {
     Rgb,
@@ -159,6 +164,20 @@ impl InputOp {
                 s.set_f(self.out, n as f32)
             }
             Source::RayLength => s.set_f(self.out, g.ray_length),
+            Source::RandomPerIsland => {
+                // The face's island (its representative vertex, in 16-bit halves), hashed as
+                // Cycles does; 0 without the attribute, as Cycles reads a missing one.
+                let v = match g.color_attribute(ISLAND_ATTRIBUTE) {
+                    Some(c) => {
+                        // Rounded: interpolation over the face may move it off the integer.
+                        let half = |v: f32| (v.round().clamp(0.0, 65535.0)) as u32;
+                        let id = half(c.x) | (half(c.y) << 16);
+                        crate::shading::tex::hash::hash_uint_to_float(id)
+                    }
+                    None => 0.0,
+                };
+                s.set_f(self.out, v);
+            }
             Source::Color(name, alpha) => {
                 let c = g.color_attribute(name).unwrap_or(glam::Vec4::ZERO);
                 if *alpha {
@@ -288,17 +307,12 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             emit(cx, "Incoming", Vector, Source::Incoming)?;
             emit(cx, "Parametric", Vector, Source::Parametric)?;
             emit(cx, "Backfacing", Float, Source::Backfacing)?;
-            match cx.wanted() {
-                Some("Pointiness") => cx.warn("Pointiness is not rendered; it reads as 0.5"),
-                Some("Random Per Island") => {
-                    cx.warn("Random Per Island is not rendered; it reads as 0")
-                }
-                _ => {}
+            emit(cx, "Random Per Island", Float, Source::RandomPerIsland)?;
+            if cx.wanted() == Some("Pointiness") {
+                cx.warn("Pointiness is not rendered; it reads as 0.5");
             }
             let half = cx.constant(&[0.5])?;
             cx.alias("Pointiness", half, Float);
-            let zero = cx.constant(&[0.0])?;
-            cx.alias("Random Per Island", zero, Float);
         }
         "ShaderNodeObjectInfo" => {
             emit(cx, "Location", Vector, Source::ObjectLocation)?;
