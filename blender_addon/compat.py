@@ -215,6 +215,16 @@ def normals(mesh, n_loops):
     return "CORNER", corner_normals(mesh, n_loops)
 
 
+def vertex_normals(mesh, n_verts):
+    """Blender's vertex normals, float32 (n_verts, 3) (4.1 moved them off the vertices)."""
+    out = np.empty(n_verts * 3, dtype=np.float32)
+    if hasattr(mesh, "vertex_normals"):
+        mesh.vertex_normals.foreach_get("vector", out)
+    else:
+        mesh.vertices.foreach_get("normal", out)
+    return out.reshape(-1, 3)
+
+
 def corner_normals(mesh, n_loops):
     """Per-corner (split) normals, float32 (n_loops, 3)."""
     if hasattr(mesh, "corner_normals"):  # 4.1+

@@ -136,26 +136,101 @@ def undeformed_positions(obj, co, render=True):
 ISLAND_ATTRIBUTE = ".tesela.island"
 
 
-def _tree_uses_random_per_island(tree, seen):
+# The point attribute carrying Geometry > Pointiness.
+POINTINESS_ATTRIBUTE = ".tesela.pointiness"
+_DERIVED_OUTPUTS = ("Random Per Island", "Pointiness")
+
+
+def _tree_geometry_outputs(tree, seen, found):
     if tree is None or tree.name in seen:
-        return False
+        return
     seen.add(tree.name)
     for node in tree.nodes:
         if node.bl_idname == "ShaderNodeNewGeometry":
-            out = node.outputs.get("Random Per Island")
-            if out is not None and out.is_linked:
-                return True
+            for name in _DERIVED_OUTPUTS:
+                out = node.outputs.get(name)
+                if out is not None and out.is_linked:
+                    found.add(name)
         elif getattr(node, "node_tree", None) is not None:
-            if _tree_uses_random_per_island(node.node_tree, seen):
-                return True
-    return False
+            _tree_geometry_outputs(node.node_tree, seen, found)
 
 
-def _uses_random_per_island(mesh):
-    """Whether a material of the mesh reads Geometry > Random Per Island."""
-    seen = set()
-    return any(m is not None and _tree_uses_random_per_island(compat.node_tree(m), seen)
-               for m in mesh.materials)
+def _geometry_outputs_used(mesh):
+    """Which of the Geometry node's derived outputs (Random Per Island, Pointiness) the
+    mesh's materials read: the add-on computes those attributes only then."""
+    seen, found = set(), set()
+    for m in mesh.materials:
+        if m is not None:
+            _tree_geometry_outputs(compat.node_tree(m), seen, found)
+    return found
+
+
+def _edges(mesh):
+    edges = np.empty(len(mesh.edges) * 2, dtype=np.int64)
+    if len(edges):
+        mesh.edges.foreach_get("vertices", edges)
+    return edges.reshape(-1, 2)
+
+
+def _pointiness(co, vertex_normals, edges):
+    """Cycles' Pointiness (its attr_create_pointiness) per vertex, as (n, 4) float32 (p, p, p,
+    1): coincident vertices welded (within FLT_EPSILON, found along the coordinate sum), each
+    vertex's angle between its welded normal and the mean direction of its edges over pi, then
+    averaged with its one-ring neighbours."""
+    n = co.shape[0]
+    eps = np.float32(np.finfo(np.float32).eps)
+    co = co.astype(np.float32)
+    total = (co[:, 0] + co[:, 1]) + co[:, 2]
+    # Ascending coordinate sum; coincident vertices with the higher index first.
+    order = np.lexsort((-np.arange(n), total))
+    orig = np.arange(n)
+    sums = total[order]
+    ends = np.searchsorted(sums, sums + 3 * eps, side="right")
+    for k in np.nonzero(ends > np.arange(n) + 1)[0].tolist():
+        v = order[k]
+        for j in range(k + 1, int(ends[k])):
+            w = order[j]
+            d = co[w] - co[v]
+            if float(np.dot(d, d)) < eps:
+                orig[v] = w
+                break
+    for v in np.nonzero(orig != np.arange(n))[0].tolist():
+        r = orig[v]
+        while orig[r] != r:
+            r = orig[r]
+        orig[v] = r
+    normal = np.zeros((n, 3), np.float32)
+    np.add.at(normal, orig, vertex_normals.astype(np.float32))
+    length = np.linalg.norm(normal, axis=1, keepdims=True)
+    normal = np.divide(normal, length, out=np.zeros_like(normal), where=length > 0)
+    # Each edge once between welded vertices, in the mesh's edge order.
+    e = orig[edges] if len(edges) else np.zeros((0, 2), np.int64)
+    key = np.minimum(e[:, 0], e[:, 1]) * n + np.maximum(e[:, 0], e[:, 1])
+    _, first = np.unique(key, return_index=True)
+    e = e[np.sort(first)]
+    v0, v1 = e[:, 0], e[:, 1]
+    d = co[v1] - co[v0]
+    dl = np.linalg.norm(d, axis=1, keepdims=True)
+    d = np.divide(d, dl, out=np.zeros_like(d), where=dl > 0)
+    accum = np.zeros((n, 3), np.float32)
+    np.add.at(accum, v0, d)
+    np.add.at(accum, v1, -d)
+    count = np.zeros(n, np.int64)
+    np.add.at(count, v0, 1)
+    np.add.at(count, v1, 1)
+    raw = np.zeros(n, np.float32)
+    has = (count > 0) & (orig == np.arange(n))
+    mean = accum[has] / count[has, None].astype(np.float32)
+    cos = np.clip(np.sum(normal[has] * mean, axis=1), -1.0, 1.0)
+    raw[has] = np.arccos(cos) / np.float32(np.pi)
+    data = raw.copy()
+    np.add.at(data, v0, raw[v1])
+    np.add.at(data, v1, raw[v0])
+    data /= (count + 1).astype(np.float32)
+    data = data[orig]
+    out = np.ones((n, 4), np.float32)
+    out[:, :3] = data[:, None]
+    return out
 
 
 def _island_ids(mesh, raw, n_verts):
@@ -163,10 +238,7 @@ def _island_ids(mesh, raw, n_verts):
     connected component, from joining every edge's vertices in the mesh's edge order with
     union by rank (Cycles' DisjointSet; the renderer hashes the index). (n_faces, 4) float32
     holding the index's low and high 16 bits, exact for any vertex count."""
-    n_edges = len(mesh.edges)
-    edges = np.empty(n_edges * 2, dtype=np.int64)
-    if n_edges:
-        mesh.edges.foreach_get("vertices", edges)
+    edges = _edges(mesh)
     parent = list(range(n_verts))
     rank = [0] * n_verts
 
@@ -178,7 +250,7 @@ def _island_ids(mesh, raw, n_verts):
             parent[x], x = root, parent[x]
         return root
 
-    for a, b in edges.reshape(-1, 2).tolist():
+    for a, b in edges.tolist():
         ra, rb = find(a), find(b)
         if ra == rb:
             continue
@@ -236,8 +308,12 @@ def read_mesh(mesh, check_cancel=None, phases=None):
         skip = {name for name, _, _ in raw.colors} | {name for name, _ in raw.uvs}
         raw.colors += [(name, values, domain) for name, domain, values
                        in compat.generic_attributes(mesh, counts, skip)]
-        if _uses_random_per_island(mesh):
+        uses = _geometry_outputs_used(mesh)
+        if "Random Per Island" in uses:
             raw.colors.append((ISLAND_ATTRIBUTE, _island_ids(mesh, raw, n_verts), "FACE"))
+        if "Pointiness" in uses:
+            p = _pointiness(raw.co, compat.vertex_normals(mesh, n_verts), _edges(mesh))
+            raw.colors.append((POINTINESS_ATTRIBUTE, p, "POINT"))
         if any(domain == "FACE" for _, _, domain in raw.colors):
             # Each corner takes its face's value (faces' corners are consecutive).
             face_corners = np.diff(np.append(raw.loop_start, n_loops))

@@ -385,6 +385,31 @@ def random_per_island():
     scenes.add_camera((0.0, 0.0, 4.0), (0.0, 0.0, 0.0), fov=math.radians(50.0))
 
 
+def pointiness():
+    """Geometry > Pointiness through a steep Color Ramp (0.45 to 0.55) as emission, on a
+    subdivided Suzanne and on a row of touching cubes (an Array that does not merge, then
+    Bevel): Cycles' curvature estimate, with the coincident vertices where the cubes touch
+    welded."""
+    mat, nt, out = node_material("Pointiness")
+    ramp = node(nt, "ShaderNodeValToRGB",
+                Fac=node(nt, "ShaderNodeNewGeometry").outputs["Pointiness"])
+    ramp.color_ramp.elements[0].position = 0.45
+    ramp.color_ramp.elements[1].position = 0.55
+    surface(nt, out, node(nt, "ShaderNodeEmission", Color=ramp.outputs["Color"]).outputs[0])
+    bpy.ops.mesh.primitive_monkey_add(size=1.2, location=(-0.8, 0.0, 0.4))
+    monkey = bpy.context.active_object
+    monkey.modifiers.new("Subdivision", "SUBSURF").render_levels = 1
+    monkey.data.materials.append(mat)
+    bpy.ops.mesh.primitive_cube_add(size=0.3, location=(0.35, 0.0, -0.5))
+    cubes = bpy.context.active_object
+    arr = cubes.modifiers.new("Row", "ARRAY")
+    arr.count, arr.relative_offset_displace, arr.use_merge_vertices = 4, (1.0, 0, 0), False
+    cubes.modifiers.new("Bevel", "BEVEL").width = 0.03
+    cubes.rotation_euler = (0.5, 0.3, 0.2)
+    cubes.data.materials.append(mat)
+    scenes.add_camera((0.0, -4.0, 0.3), (0.0, 0.0, 0.0), fov=math.radians(40.0))
+
+
 def smooth_principled_ball():
     """A Principled BSDF at roughness 0 (a delta specular layer over its diffuse base) with a
     Specular Tint of (0, 0.5, 1) in a bright world: Cycles' generalized Schlick Fresnel, exact
@@ -1051,6 +1076,7 @@ CASES = [
     ("no_material_default_surface", no_material_ball, 2, 128, 512),
     ("principled_smooth_tinted", smooth_principled_ball, 2, 128, 512),
     ("random_per_island", random_per_island, 0, 64, 256),
+    ("pointiness", pointiness, 0, 64, 256),
     ("named_float_attribute_points", named_attribute("FLOAT", "POINT", "Fac"), 0, 64, 256),
     ("named_float_attribute_faces", named_attribute("FLOAT", "FACE", "Color"), 0, 64, 256),
     ("named_vector_attribute_points", named_attribute("FLOAT_VECTOR", "POINT", "Vector"),

@@ -62,10 +62,14 @@ pub enum Source {
 /// Which part of an attribute the Attribute node's output carries.
 /// The face attribute the add-on writes each face's island into (Random Per Island).
 pub const ISLAND_ATTRIBUTE: &str = ".tesela.island";
+/// The point attribute the add-on writes Cycles' Pointiness into.
+pub const POINTINESS_ATTRIBUTE: &str = ".tesela.pointiness";
 
 #[derive(Clone, Copy, Debug)]
 pub enum AttrPart {
     Rgb,
+    /// The first component (attributes the add-on derives, stored as `(v, v, v, 1)`).
+    First,
     /// Cycles' Fac: the mean of the three components.
     Average,
     Alpha,
@@ -197,6 +201,7 @@ impl InputOp {
                 };
                 match part {
                     AttrPart::Rgb => s.set_v(self.out, v.truncate()),
+                    AttrPart::First => s.set_f(self.out, v.x),
                     AttrPart::Average => s.set_f(self.out, (v.x + v.y + v.z) / 3.0),
                     AttrPart::Alpha => s.set_f(self.out, v.w),
                 }
@@ -308,11 +313,12 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             emit(cx, "Parametric", Vector, Source::Parametric)?;
             emit(cx, "Backfacing", Float, Source::Backfacing)?;
             emit(cx, "Random Per Island", Float, Source::RandomPerIsland)?;
-            if cx.wanted() == Some("Pointiness") {
-                cx.warn("Pointiness is not rendered; it reads as 0.5");
-            }
-            let half = cx.constant(&[0.5])?;
-            cx.alias("Pointiness", half, Float);
+            emit(
+                cx,
+                "Pointiness",
+                Float,
+                Source::Attribute(POINTINESS_ATTRIBUTE.to_string(), AttrPart::First),
+            )?;
         }
         "ShaderNodeObjectInfo" => {
             emit(cx, "Location", Vector, Source::ObjectLocation)?;
