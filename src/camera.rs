@@ -11,9 +11,10 @@
 //! v + s.y)` to a direction ([`Panorama`]).
 
 use crate::sampling::{square_to_regular_polygon, square_to_uniform_disk};
-use crate::scene::{Aperture, Camera, Panorama, Projection, Scene};
+use crate::scene::{Aperture, Camera, Panorama, Projection, Scene, SensorFit};
 use glam::{Mat4, Vec2, Vec3};
 use std::f32::consts::FRAC_PI_2;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// One camera ray in world space: origin `o`, unit direction `d`, and the segment length
 /// `tmax` before the far clip distance (infinite without one).
@@ -273,6 +274,118 @@ impl RayCamera {
             o,
             d,
             tmax: (self.clip_end - self.clip_start) * scale,
+        }
+    }
+}
+
+/// Blender's Window texture coordinates of world points (Cycles' `camera_world_to_ndc`): the
+/// camera frame's `[0, 1]²`, `(0, 0)` at its bottom-left corner, lens shift included, `z = 0`.
+/// The frame's aspect follows the resolution of the latest render
+/// ([`WindowMap::set_resolution`]), which is why it is atomic: renders share the scene.
+#[derive(Debug)]
+pub struct WindowMap {
+    world_to_camera: Mat4,
+    /// `Some(perspective)` for perspective and orthographic cameras; `None` for panoramas,
+    /// whose Window coordinates Tesela does not compute.
+    perspective: Option<bool>,
+    /// `tan(yfov / 2)` (perspective) or the half height in metres (orthographic) of the
+    /// fitted dimension.
+    fitted: f32,
+    fit: SensorFit,
+    shift: Vec2,
+    width: AtomicU32,
+    height: AtomicU32,
+}
+
+/// Window coordinates where there is no camera (emitters' set-up, tests): `(0, 0, 0)`.
+pub static NO_WINDOW: WindowMap = WindowMap::none();
+
+impl WindowMap {
+    /// No camera: every point reads `(0, 0, 0)`.
+    pub const fn none() -> WindowMap {
+        WindowMap {
+            world_to_camera: Mat4::IDENTITY,
+            perspective: None,
+            fitted: 1.0,
+            fit: SensorFit::Auto,
+            shift: Vec2::ZERO,
+            width: AtomicU32::new(1),
+            height: AtomicU32::new(1),
+        }
+    }
+
+    /// The scene's camera (or the default one), for a square frame until a resolution is set.
+    pub fn new(scene: &Scene) -> WindowMap {
+        let cam = scene.camera.unwrap_or_else(|| default_camera(scene));
+        let (perspective, fitted) = match cam.projection {
+            Projection::Perspective { yfov } => (Some(true), (yfov * 0.5).tan()),
+            Projection::Orthographic { ymag } => (Some(false), ymag),
+            Projection::Panoramic(_) => (None, 1.0),
+        };
+        // Shading points are in Blender's world (Z up); the camera is in glTF's (Y up).
+        let blender = Mat4::from_cols(
+            glam::Vec4::X,
+            glam::Vec4::new(0.0, 0.0, 1.0, 0.0),
+            glam::Vec4::new(0.0, -1.0, 0.0, 0.0),
+            glam::Vec4::W,
+        );
+        WindowMap {
+            world_to_camera: (blender * cam.to_world).inverse(),
+            perspective,
+            fitted,
+            fit: cam.fit,
+            shift: cam.shift,
+            width: AtomicU32::new(1),
+            height: AtomicU32::new(1),
+        }
+    }
+
+    /// Whether the camera's Window coordinates are computed (not a panorama).
+    pub fn supported(&self) -> bool {
+        self.perspective.is_some()
+    }
+
+    pub fn resolution(&self) -> (u32, u32) {
+        (
+            self.width.load(Ordering::Relaxed),
+            self.height.load(Ordering::Relaxed),
+        )
+    }
+
+    pub fn set_resolution(&self, width: u32, height: u32) {
+        self.width.store(width.max(1), Ordering::Relaxed);
+        self.height.store(height.max(1), Ordering::Relaxed);
+    }
+
+    /// The Window coordinates of point `p` (Blender's world space); `(0, 0, 0)` where they are not finite (in
+    /// the camera's plane) or not computed.
+    #[inline]
+    pub fn window(&self, p: Vec3) -> Vec3 {
+        let Some(perspective) = self.perspective else {
+            return Vec3::ZERO;
+        };
+        let (w, h) = (
+            self.width.load(Ordering::Relaxed),
+            self.height.load(Ordering::Relaxed),
+        );
+        let aspect = w as f32 / h as f32;
+        let f = self.fitted;
+        let half = if self.fit.is_horizontal(w, h) {
+            Vec2::new(f, f / aspect)
+        } else {
+            Vec2::new(f * aspect, f)
+        };
+        let q = self.world_to_camera.transform_point3(p);
+        let plane = if perspective {
+            Vec2::new(q.x, q.y) / -q.z
+        } else {
+            Vec2::new(q.x, q.y)
+        };
+        let ndc = ((plane - 2.0 * f * self.shift) / half + Vec2::ONE) * 0.5;
+        if ndc.is_finite() {
+            ndc.extend(0.0)
+        } else {
+            Vec3::ZERO
         }
     }
 }

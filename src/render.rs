@@ -412,6 +412,7 @@ fn prepare(scene: &RenderScene, opts: &RenderOptions) -> Result<Prepared, Render
     let integrator =
         integrator::by_name_with(&opts.integrator, opts.max_depth.max(1), opts.light_paths)
             .ok_or_else(|| RenderError::Invalid("unknown integrator".into()))?;
+    scene.set_window_resolution(opts.width, opts.height);
     Ok(Prepared {
         integrator,
         camera: RayCamera::new(&scene.scene, opts.width, opts.height),

@@ -311,6 +311,8 @@ pub struct RenderScene {
     holdouts: bool,
     /// The camera in Blender's coordinates, for the graph's Camera coordinates.
     camera_to_world: Mat4,
+    /// The camera's Window coordinates (shared with the mesh emitters).
+    window: Arc<crate::camera::WindowMap>,
     /// The world-space meshes.
     accel: Accel,
     /// The instances (two levels), if any.
@@ -440,7 +442,7 @@ impl LightParts {
     fn new(
         scene: &Scene,
         programs: &[Arc<Program>],
-        camera_to_world: Mat4,
+        (camera_to_world, window): (Mat4, &Arc<crate::camera::WindowMap>),
         (triangles, radius): (usize, f32),
         choice: LightChoice,
         warnings: &mut Vec<String>,
@@ -459,7 +461,9 @@ impl LightParts {
             match AreaEmitter::with_program(scene, mi, program.clone()) {
                 Some(e) => {
                     mesh_emitter[mi] = Some(emitters.len() as u32);
-                    emitters.push(EmitterInstance::Area(e.with_camera(camera_to_world)));
+                    emitters.push(EmitterInstance::Area(
+                        e.with_camera(camera_to_world, window.clone()),
+                    ));
                     // An object hidden from a closure's rays does not light it by emitter
                     // sampling either (Cycles' SHADER_EXCLUDE_* of mesh lights).
                     let v = m.attrs.object.visibility;
@@ -578,10 +582,25 @@ impl RenderScene {
             None => 1.0,
         };
         let camera_to_world = blender_camera_to_world(&scene);
+        let window = Arc::new(crate::camera::WindowMap::new(&scene));
+        if !window.supported() {
+            for m in &scene.materials {
+                let node = m
+                    .graph
+                    .as_ref()
+                    .and_then(|g| g.node_with_linked_output("ShaderNodeTexCoord", "Window"));
+                if let Some(n) = node {
+                    scene.warnings.push(format!(
+                        "material '{}': node '{}': Window coordinates are not rendered for a panoramic camera; they read as (0, 0, 0)",
+                        m.name, n.name
+                    ));
+                }
+            }
+        }
         let parts = LightParts::new(
             &scene,
             &programs,
-            camera_to_world,
+            (camera_to_world, &window),
             (n, radius),
             choice,
             &mut warnings,
@@ -593,6 +612,7 @@ impl RenderScene {
         let hides = hidden_rays(&scene);
         let holdouts = any_holdout(&scene);
         let mut rs = RenderScene {
+            window,
             scene,
             passes,
             absorbs,
@@ -742,7 +762,7 @@ impl RenderScene {
         let parts = LightParts::new(
             &self.scene,
             &self.programs,
-            self.camera_to_world,
+            (self.camera_to_world, &self.window),
             (self.triangles, self.radius),
             self.choice,
             &mut warnings,
@@ -757,9 +777,14 @@ impl RenderScene {
     pub fn set_camera(&mut self, camera: Option<crate::scene::Camera>) {
         self.scene.camera = camera;
         self.camera_to_world = blender_camera_to_world(&self.scene);
+        let (w, h) = self.window.resolution();
+        let window = crate::camera::WindowMap::new(&self.scene);
+        window.set_resolution(w, h);
+        self.window = Arc::new(window);
         for e in &mut self.emitters {
             if let EmitterInstance::Area(a) = e {
                 a.camera_to_world = self.camera_to_world;
+                a.window = self.window.clone();
             }
         }
     }
@@ -1374,6 +1399,11 @@ impl RenderScene {
         }
     }
 
+    /// The image size Window coordinates span (each render sets its own).
+    pub fn set_window_resolution(&self, width: u32, height: u32) {
+        self.window.set_resolution(width, height);
+    }
+
     /// The scene data shading programs may read.
     #[inline]
     pub fn shade_env(&self) -> ShadeEnv<'_> {
@@ -1381,6 +1411,7 @@ impl RenderScene {
             images: &self.scene.images,
             textures: &self.scene.textures,
             camera_to_world: self.camera_to_world,
+            window: &self.window,
             tracer: Some(self),
         }
     }

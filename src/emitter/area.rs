@@ -38,6 +38,8 @@ pub struct AreaEmitter {
     pub two_sided: bool,
     /// Camera to world, Blender coordinates, for the program's camera-space inputs.
     pub camera_to_world: Mat4,
+    /// The camera's Window coordinates, shared with the render scene.
+    pub window: Arc<crate::camera::WindowMap>,
 }
 
 /// Geometric (unnormalised) normal of triangle `i` by the right-hand rule: its length is twice
@@ -86,6 +88,7 @@ impl AreaEmitter {
             images: &scene.images,
             textures: &scene.textures,
             camera_to_world: Mat4::IDENTITY,
+            window: &crate::camera::NO_WINDOW,
             tracer: None,
         };
         for i in (0..varying).step_by(step) {
@@ -109,13 +112,19 @@ impl AreaEmitter {
             program,
             two_sided: material.emission_two_sided,
             camera_to_world: Mat4::IDENTITY,
+            window: Arc::new(crate::camera::WindowMap::none()),
         })
     }
 
     /// The emitter with the camera its program's camera-space inputs refer to.
-    pub fn with_camera(self, camera_to_world: Mat4) -> AreaEmitter {
+    pub fn with_camera(
+        self,
+        camera_to_world: Mat4,
+        window: Arc<crate::camera::WindowMap>,
+    ) -> AreaEmitter {
         AreaEmitter {
             camera_to_world,
+            window,
             ..self
         }
     }
@@ -127,6 +136,7 @@ impl AreaEmitter {
             images: &scene.images,
             textures: &scene.textures,
             camera_to_world: self.camera_to_world,
+            window: &self.window,
             tracer: None,
         };
         let m = &scene.meshes[self.mesh];
@@ -300,6 +310,7 @@ const ENV0: ShadeEnv<'static> = ShadeEnv {
     images: &[],
     textures: &[],
     camera_to_world: Mat4::IDENTITY,
+    window: &crate::camera::NO_WINDOW,
     tracer: None,
 };
 

@@ -411,6 +411,7 @@ impl Environment {
             images: &scene.images,
             textures: &scene.textures,
             camera_to_world: self.camera_to_world,
+            window: &crate::camera::NO_WINDOW,
             tracer: None,
         }
     }
@@ -573,6 +574,12 @@ pub fn world_emitter(
         if !warnings.contains(&w) {
             warnings.push(w);
         }
+    }
+    if let Some(n) = graph.node_with_linked_output("ShaderNodeTexCoord", "Window") {
+        warnings.push(format!(
+            "world '{name}': node '{}': Window coordinates are not rendered in the world; they read as (0, 0, 0)",
+            n.name
+        ));
     }
     let program = compiled.program;
     if let Some(set) = &program.constant {

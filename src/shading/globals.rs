@@ -74,6 +74,8 @@ pub struct ShadeEnv<'a> {
     pub textures: &'a [Texture],
     /// Camera to world, Blender coordinates (the camera looks down its local -Z).
     pub camera_to_world: Mat4,
+    /// The camera's Window coordinates.
+    pub window: &'a crate::camera::WindowMap,
     /// The scene's geometry for the rays a program casts; `None` where there is none to
     /// trace (emitters' set-up, tests): such rays see nothing.
     pub tracer: Option<&'a dyn Tracer>,

@@ -91,6 +91,20 @@ pub struct Graph {
 }
 
 impl Graph {
+    /// The first node of `kind` whose output `output` some node reads (for reports).
+    pub fn node_with_linked_output(&self, kind: &str, output: &str) -> Option<&Node> {
+        self.nodes.iter().enumerate().find_map(|(i, n)| {
+            let read = self.nodes.iter().any(|m| {
+                m.inputs.iter().any(|(_, inp)| {
+                    matches!(inp, Input::Link { node, output: o } if *node == i && o == output)
+                })
+            }) || [&self.surface, &self.displacement, &self.volume]
+                .into_iter()
+                .any(|r| matches!(r, Some((node, o)) if *node == i && o == output));
+            (n.kind == kind && read).then_some(n)
+        })
+    }
+
     /// Appends a node and returns its index.
     pub fn add(&mut self, node: Node) -> usize {
         self.nodes.push(node);

@@ -61,6 +61,7 @@ mod tests {
             images: &[],
             textures: &[],
             camera_to_world: glam::Mat4::IDENTITY,
+            window: &crate::camera::NO_WINDOW,
             tracer: None,
         }
     }

@@ -132,6 +132,7 @@ impl Program {
             images: &[],
             textures: &[],
             camera_to_world: glam::Mat4::IDENTITY,
+            window: &crate::camera::NO_WINDOW,
             tracer: None,
         };
         let mut scratch = Scratch::default();

@@ -1,6 +1,7 @@
 """Blender cameras through the add-on (TESELA_camera) against Cycles on the same scene: depth of
 field with a polygonal, rotated, anamorphic bokeh and a focus object, lens shift on a wide image,
-an orthographic camera with vertical sensor fit and shift, clip start and end, and panoramic cameras
+an orthographic camera with vertical sensor fit and shift, Window texture coordinates (a camera projection,
+perspective and orthographic, shifted), clip start and end, and panoramic cameras
 (fisheye equisolid, equidistant and a partial equirectangular).
 
 Criteria (imgcompare.compare): each RGB channel's mean within 2%, 8x8 block means within 5% at
@@ -97,6 +98,35 @@ def ortho_vertical_shift():
     return info
 
 
+def window_projection(ortho):
+    """Every surface shows a checker through Window coordinates (a camera projection, as for
+    a matte painting) with the lens shifted: the squares stay square to the frame whatever
+    the geometry; orthographic with vertical sensor fit too."""
+    info = lit_scene()
+    mat = bpy.data.materials.new("Projected")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.remove(nt.nodes["Principled BSDF"])
+    coords = nt.nodes.new("ShaderNodeTexCoord")
+    checker = nt.nodes.new("ShaderNodeTexChecker")
+    checker.inputs["Scale"].default_value = 6.0
+    emission = nt.nodes.new("ShaderNodeEmission")
+    nt.links.new(coords.outputs["Window"], checker.inputs["Vector"])
+    nt.links.new(checker.outputs["Color"], emission.inputs["Color"])
+    nt.links.new(emission.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+    for ob in bpy.context.scene.objects:
+        if ob.type == "MESH":
+            ob.data.materials.clear()
+            ob.data.materials.append(mat)
+    cam = camera()
+    cam.shift_x, cam.shift_y = 0.12, -0.08
+    if ortho:
+        cam.type = "ORTHO"
+        cam.ortho_scale = 5.0
+        cam.sensor_fit = "VERTICAL"
+    return info
+
+
 def clip_start():
     """The near clip plane cuts away the front of the floor (the world shows there)."""
     info = lit_scene(world=0.5)
@@ -132,6 +162,8 @@ CASES = [
     ("bokeh_hexagon_anamorphic", bokeh_hexagon, 2048),
     ("lens_shift", lens_shift, 256),
     ("ortho_vertical_shift", ortho_vertical_shift, 256),
+    ("window_projection_perspective", lambda: window_projection(False), 64),
+    ("window_projection_orthographic", lambda: window_projection(True), 64),
     ("clip_start", clip_start, 256),
     ("clip_end", clip_end, 256),
     ("fisheye_equisolid", lambda: _pano("FISHEYE_EQUISOLID", fisheye_lens=8.0,

@@ -84,6 +84,7 @@ fn shade(s: &Scene, mi: usize) -> ClosureSet {
         images: &s.images,
         textures: &s.textures,
         camera_to_world: Mat4::IDENTITY,
+        window: &crate::camera::NO_WINDOW,
         tracer: None,
     };
     let mut scratch = Scratch::default();

@@ -46,6 +46,8 @@ pub enum Source {
     Attribute(String, AttrPart),
     /// Geometry > Random Per Island, from the face attribute [`ISLAND_ATTRIBUTE`].
     RandomPerIsland,
+    /// Texture Coordinate > Window: the point's position in the camera frame.
+    Window,
     /// Layer Weight (`fresnel` output or `facing`), blend slot, optional normal slot.
     LayerWeight {
         fresnel: bool,
@@ -142,6 +144,7 @@ impl InputOp {
             Source::Object => s.set_v(self.out, g.object_position()),
             Source::ObjectOf(m) => s.set_v(self.out, m.transform_point3(g.p)),
             Source::Camera => s.set_v(self.out, camera_position(&env.camera_to_world, g.p)),
+            Source::Window => s.set_v(self.out, env.window.window(g.p)),
             Source::Reflection => s.set_v(self.out, 2.0 * g.n.dot(g.i) * g.n - g.i),
             Source::Position => s.set_v(self.out, g.p),
             Source::Normal => s.set_v(self.out, g.n),
@@ -286,12 +289,7 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             }
             emit(cx, "Camera", Vector, Source::Camera)?;
             emit(cx, "Reflection", Vector, Source::Reflection)?;
-            // Window coordinates need the projection: reported when used.
-            if cx.wanted() == Some("Window") {
-                cx.warn("Window coordinates are not rendered; they read as (0, 0, 0)");
-            }
-            let w = cx.constant(&[0.0, 0.0, 0.0])?;
-            cx.alias("Window", w, Vector);
+            emit(cx, "Window", Vector, Source::Window)?;
         }
         "TeselaGltfUv" => {
             let set = cx.prop_f32("set", 0.0).max(0.0) as usize;

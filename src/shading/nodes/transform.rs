@@ -435,6 +435,7 @@ mod tests {
             images: &[],
             textures: &[],
             camera_to_world: cam,
+            window: &crate::camera::NO_WINDOW,
             tracer: None,
         };
         let g = ShaderGlobals::at(Vec3::ZERO, Vec3::Y, glam::Vec2::ZERO);
