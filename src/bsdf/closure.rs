@@ -250,7 +250,10 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
     let alpha = blurred(alpha0, blur);
     let (ax, ay) = (blurred(ax0, blur), blurred(ay0, blur));
     // Energy compensation as set up before the blur: none for a lobe that was smooth.
-    let (ms, ms_aniso) = (alpha0 >= DELTA_ALPHA, ax0.max(ay0) >= DELTA_ALPHA);
+    let (ms, ms_aniso) = (
+        p.multiscatter && alpha0 >= DELTA_ALPHA,
+        p.multiscatter && ax0.max(ay0) >= DELTA_ALPHA,
+    );
     let metallic = p.metallic.clamp(0.0, 1.0);
     let transmission = p.transmission.clamp(0.0, 1.0) * (1.0 - metallic);
     let base = if u < transmission {
@@ -345,7 +348,12 @@ pub fn principled_base_attenuation(p: &Principled, wi: Vec3) -> Vec3 {
         let ior = principled_specular_ior(p.ior, p.specular_level);
         let (ax, ay) = (ax.max(DELTA_ALPHA), ay.max(DELTA_ALPHA));
         let specular = RoughDielectric::principled_specular(p.specular_tint, ior, ax, ay);
-        att *= Layer::attenuation(&specular.multiscatter(), wi);
+        let specular = if p.multiscatter {
+            specular.multiscatter()
+        } else {
+            specular
+        };
+        att *= Layer::attenuation(&specular, wi);
     }
     if p.coat_weight > 0.0 {
         let coat = Coat::new(p.coat_weight, p.coat_roughness, p.coat_ior, p.coat_tint);

@@ -41,6 +41,9 @@ pub struct Principled {
     /// Blender's Principled (F82 metals, multiple-scattering GGX, coat and sheen layers);
     /// false for glTF materials, which keep their Schlick metal and single-scattering GGX.
     pub cycles: bool,
+    /// The Multiscatter GGX distribution (Blender's default), whose energy compensation the
+    /// metal, specular and transmission lobes get; false for plain GGX.
+    pub multiscatter: bool,
 }
 
 impl Principled {
@@ -71,6 +74,7 @@ impl Principled {
             subsurface_anisotropy: 0.0,
             diffuse_roughness: 0.0,
             cycles: true,
+            multiscatter: true,
         }
     }
 }

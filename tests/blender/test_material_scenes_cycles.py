@@ -410,6 +410,23 @@ def pointiness():
     scenes.add_camera((0.0, -4.0, 0.3), (0.0, 0.0, 0.0), fov=math.radians(40.0))
 
 
+def principled_ggx(kind):
+    """A Principled BSDF set to plain GGX (3.x's default, which older files keep): no
+    multiple-scattering energy compensation, so rough lobes lose energy. A rough half-metal
+    (metal and specular over diffuse), or rough glass (transmission 1, roughness 0.9)."""
+    def build():
+        mat, nt, out = node_material("PrincipledGGX")
+        if kind == "glass":
+            p = principled(nt, out, Base_Color=(0.9, 0.95, 1.0, 1.0), Roughness=0.9,
+                           Transmission_Weight=1.0)
+        else:
+            p = principled(nt, out, Base_Color=(0.9, 0.6, 0.3, 1.0), Roughness=0.8,
+                           Metallic=0.5)
+        p.distribution = "GGX"
+        _sphere_stage(mat, world_strength=1.0)
+    return build
+
+
 def smooth_principled_ball():
     """A Principled BSDF at roughness 0 (a delta specular layer over its diffuse base) with a
     Specular Tint of (0, 0.5, 1) in a bright world: Cycles' generalized Schlick Fresnel, exact
@@ -1076,6 +1093,8 @@ CASES = [
     ("no_material_default_surface", no_material_ball, 2, 128, 512),
     ("principled_smooth_tinted", smooth_principled_ball, 2, 128, 512),
     ("random_per_island", random_per_island, 0, 64, 256),
+    ("principled_ggx_half_metal", principled_ggx("metal"), 2, 128, 512),
+    ("principled_ggx_rough_glass", principled_ggx("glass"), 6, 128, 512),
     ("pointiness", pointiness, 0, 64, 256),
     ("named_float_attribute_points", named_attribute("FLOAT", "POINT", "Fac"), 0, 64, 256),
     ("named_float_attribute_faces", named_attribute("FLOAT", "FACE", "Color"), 0, 64, 256),

@@ -56,6 +56,7 @@ pub struct PrincipledSlots {
     emission_color: Slot,
     emission_strength: Slot,
     cycles: bool,
+    multiscatter: bool,
 }
 
 /// How a Metallic BSDF gives its reflectance.
@@ -75,6 +76,8 @@ pub enum ClosureParams {
     /// Principled BSDF's metallic lobe.
     Metallic {
         fresnel: MetalFresnel,
+        /// Multiscatter GGX (else plain GGX).
+        multiscatter: bool,
         roughness: Slot,
         anisotropy: Slot,
         rotation: Slot,
@@ -292,6 +295,7 @@ impl ClosureOp {
                     subsurface_anisotropy: s.f(p.subsurface_anisotropy),
                     diffuse_roughness: s.f(p.diffuse_roughness),
                     cycles: p.cycles,
+                    multiscatter: p.multiscatter,
                 };
                 push(
                     out,
@@ -303,6 +307,7 @@ impl ClosureOp {
             }
             ClosureParams::Metallic {
                 fresnel,
+                multiscatter,
                 roughness,
                 anisotropy,
                 rotation,
@@ -322,6 +327,7 @@ impl ClosureOp {
                     specular_tint: tint,
                     anisotropic: s.f(*anisotropy).clamp(0.0, 1.0),
                     anisotropic_rotation: s.f(*rotation),
+                    multiscatter: *multiscatter,
                     ..Principled::lobe_only()
                 };
                 push(
@@ -743,6 +749,8 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                 emission_color: c(cx, "Emission Color", Vec3::ONE)?,
                 emission_strength: f(cx, "Emission Strength", 0.0)?,
                 cycles: !cx.prop_bool("gltf", false),
+                // Blender 3.x and 4.x files keep GGX where it was chosen (3.x's default).
+                multiscatter: cx.prop_str("distribution").unwrap_or("MULTI_GGX") != "GGX",
             };
             if cx.is_linked("Alpha") || cx.const_value("Alpha").is_some_and(|v| v[0] < 1.0) {
                 cx.passes();
@@ -779,12 +787,16 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                     tint: cx.color("Edge Tint", Vec3::new(0.695, 0.726, 0.770))?,
                 }
             };
-            match cx.prop_str("distribution").unwrap_or("MULTI_GGX") {
-                "MULTI_GGX" => {}
-                d => cx.warn(&format!(
-                    "distribution {d} renders as Multiscatter GGX (energy-conserving)"
-                )),
-            }
+            let multiscatter = match cx.prop_str("distribution").unwrap_or("MULTI_GGX") {
+                "MULTI_GGX" => true,
+                "GGX" => false,
+                d => {
+                    cx.warn(&format!(
+                        "distribution {d} renders as Multiscatter GGX (energy-conserving)"
+                    ));
+                    true
+                }
+            };
             if cx.is_linked("Thin Film Thickness")
                 || cx
                     .const_value("Thin Film Thickness")
@@ -794,6 +806,7 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
             }
             ClosureParams::Metallic {
                 fresnel,
+                multiscatter,
                 roughness: cx.float("Roughness", 0.5)?,
                 anisotropy: cx.float("Anisotropy", 0.0)?,
                 rotation: cx.float("Rotation", 0.0)?,
