@@ -520,6 +520,15 @@ impl LightParts {
             emitters.push(world);
         }
         visibility.resize(emitters.len(), LightVisibility::default());
+        if let Some(b) = background {
+            let w = &scene.world;
+            visibility[b as usize] = LightVisibility {
+                diffuse: w.visible_diffuse,
+                glossy: w.visible_glossy,
+                transmission: w.visible_transmission,
+                ..LightVisibility::default()
+            };
+        }
         let (mut light_shapes, mut bounds, mut suns) = (Vec::new(), Vec::new(), Vec::new());
         for (i, e) in emitters.iter().enumerate() {
             match e {
@@ -1568,13 +1577,18 @@ impl RenderScene {
 
     /// Background radiance for a ray leaving the scene along `d` from `from`, leading to path
     /// vertex `depth` with Light Path bits `flags`. Camera rays see nothing when the world is
-    /// hidden from the camera or the film is transparent.
+    /// hidden from the camera or the film is transparent; rays scattered by a kind of closure
+    /// the world is hidden from (diffuse, glossy, transmission) neither.
     #[inline]
     pub fn background_radiance(&self, d: Vec3, from: Vec3, depth: u32, flags: u32) -> Emitted {
         let b = self.background?;
         if flags & crate::shading::globals::ray::CAMERA != 0
             && (!self.scene.world.visible_camera || self.scene.settings.film_transparent)
         {
+            return None;
+        }
+        // Closures the world is hidden from do not see it along the rays they scatter.
+        if depth > 1 && !self.ray_sees(b, depth, flags) {
             return None;
         }
         let rec = EmitterQueryRecord::towards(from, d);

@@ -93,12 +93,11 @@ def convert_world(world, warnings, images=None):
             images.report = saved
     vis = getattr(world, "cycles_visibility", None)
     if vis is not None:
-        out["visible_camera"] = bool(getattr(vis, "camera", True))
-        hidden = [k for k in ("diffuse", "glossy", "transmission", "scatter")
-                  if not getattr(vis, k, True)]
-        if hidden:
-            warnings.append("world '%s': ray visibility (%s off) is not supported; the world "
-                            "is visible to those rays" % (world.name, ", ".join(hidden)))
+        for kind in ("camera", "diffuse", "glossy", "transmission"):
+            out["visible_" + kind] = bool(getattr(vis, kind, True))
+        if not getattr(vis, "scatter", True):
+            warnings.append("world '%s': ray visibility (volume scatter off) is not supported; "
+                            "the world is visible to volume scattering" % world.name)
     cw = getattr(world, "cycles", None)
     if cw is not None:
         method = getattr(cw, "sampling_method", "AUTOMATIC")

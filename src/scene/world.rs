@@ -32,6 +32,11 @@ pub struct World {
     /// Whether camera rays see the world (`world.cycles_visibility.camera`); when not, they
     /// see black (the world still lights the scene).
     pub visible_camera: bool,
+    /// Whether diffuse / glossy (reflection) / transmission closures see the world, by the
+    /// rays they scatter and by sampling it (`world.cycles_visibility`).
+    pub visible_diffuse: bool,
+    pub visible_glossy: bool,
+    pub visible_transmission: bool,
     pub sampling: WorldSampling,
 }
 
@@ -41,6 +46,9 @@ impl Default for World {
             name: "World".into(),
             graph: None,
             visible_camera: true,
+            visible_diffuse: true,
+            visible_glossy: true,
+            visible_transmission: true,
             sampling: WorldSampling::Automatic,
         }
     }

@@ -134,6 +134,18 @@ def gradient_world():
     return scene
 
 
+def hidden_world(kinds):
+    """The HDRI world hidden from the rays of ``kinds`` (world ray visibility), with a sun so
+    that something stays lit: no sky light on diffuse closures, or no sky in the glossy
+    sphere's reflections."""
+    scene = hdri_world()
+    scenes.add_sun_light("Sun", (0.3, 0.5, -0.8), 2.0)
+    vis = scene.world.cycles_visibility
+    for kind in kinds:
+        setattr(vis, kind, False)
+    return scene
+
+
 def backdrop_world():
     """Light Path: the camera sees a flat red-orange backdrop, everything else the HDRI."""
     scene = base_scene()
@@ -217,6 +229,9 @@ CASES = [
     ("hdri", lambda: hdri_world(), 4, 256, False),
     ("hdri_mapping_rot90", lambda: hdri_world(math.radians(90.0)), 4, 256, False),
     ("gradient", gradient_world, 4, 256, False),
+    ("hdri_hidden_from_diffuse", lambda: hidden_world(["diffuse"]), 4, 256, False),
+    ("hdri_hidden_from_glossy_transmission",
+     lambda: hidden_world(["glossy", "transmission"]), 4, 256, False),
     ("light_path_backdrop", backdrop_world, 4, 256, False),
     ("film_transparent", transparent_film, 4, 256, True),
     ("film_transparent_holdout", holdout_film, 4, 256, True),

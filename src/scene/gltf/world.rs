@@ -26,8 +26,16 @@ impl Loader<'_> {
                 .warnings
                 .push("TESELA_world: invalid color or strength, ignored".into());
         }
-        if let Some(v) = member(w, "visible_camera").and_then(Value::as_bool) {
-            self.scene.world.visible_camera = v;
+        let world = &mut self.scene.world;
+        for (key, flag) in [
+            ("visible_camera", &mut world.visible_camera),
+            ("visible_diffuse", &mut world.visible_diffuse),
+            ("visible_glossy", &mut world.visible_glossy),
+            ("visible_transmission", &mut world.visible_transmission),
+        ] {
+            if let Some(v) = member(w, key).and_then(Value::as_bool) {
+                *flag = v;
+            }
         }
         let resolution = member(w, "map_resolution")
             .and_then(Value::as_u64)
