@@ -456,9 +456,9 @@ def test_ray_visibility_edits_reach_the_session(recorder):
 
 
 def test_world_edit_sends_world(recorder):
+    # A world of its own: one left by other test files may read images, which asks for a load.
     scene = bpy.context.scene
-    if scene.world is None:
-        scene.world = bpy.data.worlds.new("W")
+    scene.world = bpy.data.worlds.new("ViewportEditWorld")
     recorder.index.world = scene.world.name
     load, cmds = recorder.run(lambda: setattr(scene.world, "color", (0.2, 0.3, 0.4)))
     assert not load and [c for c, _ in cmds] == ["world"]
