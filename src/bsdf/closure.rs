@@ -109,7 +109,7 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
             let (bx, by) = (blurred(ax, blur), blurred(ay, blur));
             // Blender's Glossy BSDF has no Fresnel; its colour is in the closure's weight.
             if bx.max(by) < DELTA_ALPHA {
-                BsdfInstance::Mirror(Mirror::new(*color))
+                BsdfInstance::Mirror(Mirror::with_fresnel(ConductorFresnel::Constant(*color)))
             } else {
                 let fresnel = if *color == Vec3::ONE {
                     ConductorFresnel::Weighted(*tint)
@@ -276,7 +276,10 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
         };
         if u2 < metallic {
             if ax.max(ay) < DELTA_ALPHA {
-                BaseLobe::Mirror(Mirror::new(p.base_color))
+                BaseLobe::Mirror(Mirror::with_fresnel(ConductorFresnel::f82_tint(
+                    p.base_color,
+                    p.specular_tint,
+                )))
             } else {
                 let l = RoughConductor::f82(p.base_color, p.specular_tint, ax0, ay0);
                 BaseLobe::RoughConductor(if ms_aniso { l.multiscatter() } else { l }.blurred(blur))

@@ -1,17 +1,27 @@
-//! Perfect specular reflection off a conductor: `wo = (-wi.x, -wi.y, wi.z)`, weight = Schlick
-//! Fresnel with `F0 = base colour` (white stays white at every angle).
+//! Perfect specular reflection off a conductor: `wo = (-wi.x, -wi.y, wi.z)`, weight = the
+//! conductor's Fresnel at `cos θi`: Schlick with `F0 = base colour` (glTF metals; white stays
+//! white at every angle), Cycles' F82-tint (the Principled BSDF's smooth metal), or a constant
+//! colour (Blender's Glossy BSDF, which has no Fresnel).
 
-use super::{Bsdf, BsdfQueryRecord, Measure, fresnel};
+use super::microfacet::ConductorFresnel;
+use super::{Bsdf, BsdfQueryRecord, Measure};
 use glam::{Vec2, Vec3};
 
 #[derive(Clone, Copy, Debug)]
 pub struct Mirror {
-    pub f0: Vec3,
+    pub fresnel: ConductorFresnel,
 }
 
 impl Mirror {
+    /// Schlick's Fresnel with `F0 = f0`.
     pub fn new(f0: Vec3) -> Self {
-        Mirror { f0 }
+        Mirror {
+            fresnel: ConductorFresnel::Schlick(f0),
+        }
+    }
+
+    pub fn with_fresnel(fresnel: ConductorFresnel) -> Self {
+        Mirror { fresnel }
     }
 }
 
@@ -24,7 +34,7 @@ impl Bsdf for Mirror {
         rec.eta = 1.0;
         rec.measure = Measure::Discrete;
         rec.pdf = 0.0;
-        fresnel::schlick(self.f0, rec.wi.z)
+        self.fresnel.eval(rec.wi.z)
     }
 
     fn eval(&self, _rec: &BsdfQueryRecord) -> Vec3 {

@@ -427,6 +427,15 @@ def principled_ggx(kind):
     return build
 
 
+def smooth_tinted_metal():
+    """A mirror-smooth Principled metal (roughness 0) with a blue Specular Tint in a bright
+    world: Cycles' F82-tint Fresnel colours its rim, as it does for rough metal."""
+    mat, nt, out = node_material("SmoothMetal")
+    principled(nt, out, Base_Color=(0.9, 0.6, 0.3, 1.0), Metallic=1.0, Roughness=0.0,
+               Specular_Tint=(0.2, 0.5, 1.0, 1.0))
+    _sphere_stage(mat, world_strength=1.0)
+
+
 def smooth_principled_ball():
     """A Principled BSDF at roughness 0 (a delta specular layer over its diffuse base) with a
     Specular Tint of (0, 0.5, 1) in a bright world: Cycles' generalized Schlick Fresnel, exact
@@ -1092,6 +1101,7 @@ CASES = [
     ("principled_black_base", black_base_ball, 2, 128, 512),
     ("no_material_default_surface", no_material_ball, 2, 128, 512),
     ("principled_smooth_tinted", smooth_principled_ball, 2, 128, 512),
+    ("principled_smooth_metal_f82_tint", smooth_tinted_metal, 2, 128, 512),
     ("random_per_island", random_per_island, 0, 64, 256),
     ("principled_ggx_half_metal", principled_ggx("metal"), 2, 128, 512),
     ("principled_ggx_rough_glass", principled_ggx("glass"), 6, 128, 512),
