@@ -7,10 +7,53 @@
 use crate::scene::Image;
 use std::io::Cursor;
 
-/// Largest side of a decoded image, as for glTF images.
-const MAX_SIDE: u32 = 16384;
+/// Largest side of a decoded image (glTF images and embedded files alike).
+pub(crate) const MAX_SIDE: u32 = 16384;
 /// Largest decoder allocation for one image.
 const MAX_ALLOC: u64 = 512 << 20;
+
+/// Decodes `bytes` with the `image` crate, accepting only `formats` (`supported`: their names
+/// for the messages, as "PNG and JPEG"; `either`: as "a PNG or JPEG"), within the size limits.
+pub(crate) fn read(
+    bytes: &[u8],
+    formats: &[image::ImageFormat],
+    (supported, either): (&str, &str),
+) -> Result<image::DynamicImage, String> {
+    let mut reader = image::ImageReader::new(Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| e.to_string())?;
+    match reader.format() {
+        Some(f) if formats.contains(&f) => {}
+        Some(f) => {
+            return Err(format!(
+                "unsupported image format {f:?} ({supported} are supported)"
+            ));
+        }
+        None => return Err(format!("not {either} image")),
+    }
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_SIDE);
+    limits.max_image_height = Some(MAX_SIDE);
+    limits.max_alloc = Some(MAX_ALLOC);
+    reader.limits(limits);
+    reader.decode().map_err(|e| e.to_string())
+}
+
+/// `img` as RGBA8 texels, rows top to bottom.
+pub(crate) fn bytes_image(img: &image::DynamicImage) -> Image {
+    let rgba = img.to_rgba8();
+    let (width, height) = rgba.dimensions();
+    Image {
+        width,
+        height,
+        rgba8: rgba
+            .into_raw()
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect(),
+        float: Vec::new(),
+    }
+}
 
 /// Decodes `bytes` (PNG, JPEG, Radiance HDR or OpenEXR, told apart by their signatures) into
 /// rows top to bottom. Float texels are decoded from sRGB to linear first with `linearize` (a
@@ -26,40 +69,17 @@ pub(crate) fn decode(bytes: &[u8], associate: bool, linearize: bool) -> Result<I
         }
         return Ok(img);
     }
-    let mut reader = image::ImageReader::new(Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| e.to_string())?;
-    match reader.format() {
-        Some(image::ImageFormat::Png | image::ImageFormat::Jpeg | image::ImageFormat::Hdr) => {}
-        Some(f) => {
-            return Err(format!(
-                "unsupported image format {f:?} (PNG, JPEG, Radiance HDR and OpenEXR are supported)"
-            ));
-        }
-        None => return Err("not a PNG, JPEG, Radiance HDR or OpenEXR image".into()),
-    }
-    let mut limits = image::Limits::default();
-    limits.max_image_width = Some(MAX_SIDE);
-    limits.max_image_height = Some(MAX_SIDE);
-    limits.max_alloc = Some(MAX_ALLOC);
-    reader.limits(limits);
-    let img = reader.decode().map_err(|e| e.to_string())?;
-    let (width, height) = (img.width(), img.height());
+    use image::ImageFormat::{Hdr, Jpeg, Png};
+    let names = (
+        "PNG, JPEG, Radiance HDR and OpenEXR",
+        "a PNG, JPEG, Radiance HDR or OpenEXR",
+    );
+    let img = read(bytes, &[Png, Jpeg, Hdr], names)?;
     let bits = img.color().bits_per_pixel() / u16::from(img.color().channel_count());
     if bits <= 8 {
-        let rgba8 = img
-            .to_rgba8()
-            .into_raw()
-            .chunks_exact(4)
-            .map(|c| [c[0], c[1], c[2], c[3]])
-            .collect();
-        return Ok(Image {
-            width,
-            height,
-            rgba8,
-            float: Vec::new(),
-        });
+        return Ok(bytes_image(&img));
     }
+    let (width, height) = (img.width(), img.height());
     let float = img
         .to_rgba32f()
         .into_raw()

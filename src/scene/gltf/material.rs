@@ -12,43 +12,13 @@ use super::{
 use crate::scene::{AlphaMode, Image, Material, TexRef, Texture, UvTransform, Wrap};
 
 /// Largest accepted image side, in pixels.
-const MAX_IMAGE_SIDE: u32 = 16384;
-/// Largest decoder allocation for one image.
-const MAX_IMAGE_ALLOC: u64 = 512 << 20;
+const MAX_IMAGE_SIDE: u32 = super::image_file::MAX_SIDE;
 
 /// Decodes PNG or JPEG bytes into RGBA8, rows top to bottom.
 pub(crate) fn decode_image(bytes: &[u8]) -> Result<Image, String> {
-    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| e.to_string())?;
-    match reader.format() {
-        Some(image::ImageFormat::Png | image::ImageFormat::Jpeg) => {}
-        Some(f) => {
-            return Err(format!(
-                "unsupported image format {f:?} (PNG and JPEG are supported)"
-            ));
-        }
-        None => return Err("not a PNG or JPEG image".into()),
-    }
-    let mut limits = image::Limits::default();
-    limits.max_image_width = Some(MAX_IMAGE_SIDE);
-    limits.max_image_height = Some(MAX_IMAGE_SIDE);
-    limits.max_alloc = Some(MAX_IMAGE_ALLOC);
-    reader.limits(limits);
-    let img = reader.decode().map_err(|e| e.to_string())?;
-    let rgba = img.to_rgba8();
-    let (width, height) = rgba.dimensions();
-    let rgba8 = rgba
-        .into_raw()
-        .chunks_exact(4)
-        .map(|c| [c[0], c[1], c[2], c[3]])
-        .collect();
-    Ok(Image {
-        width,
-        height,
-        rgba8,
-        float: Vec::new(),
-    })
+    use image::ImageFormat::{Jpeg, Png};
+    let img = super::image_file::read(bytes, &[Png, Jpeg], ("PNG and JPEG", "a PNG or JPEG"))?;
+    Ok(super::image_file::bytes_image(&img))
 }
 
 fn wrap(m: &Checked<WrappingMode>) -> Wrap {
