@@ -205,9 +205,7 @@ def normals(mesh, n_loops):
     values gathered to the corners (4.1+ computes them so); before 4.1 always "CORNER"."""
     domain = getattr(mesh, "normals_domain", "CORNER")
     if domain == "POINT":
-        out = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
-        mesh.vertex_normals.foreach_get("vector", out)
-        return domain, out.reshape(-1, 3)
+        return domain, vertex_normals(mesh, len(mesh.vertices))
     if domain == "FACE":
         out = np.empty(len(mesh.polygons) * 3, dtype=np.float32)
         mesh.polygon_normals.foreach_get("vector", out)

@@ -278,6 +278,14 @@ impl RayCamera {
     }
 }
 
+/// glTF's world (Y up) to Blender's (Z up): `(x, y, z) -> (x, -z, y)`.
+pub const GLTF_TO_BLENDER: Mat4 = Mat4::from_cols(
+    glam::Vec4::X,
+    glam::Vec4::new(0.0, 0.0, 1.0, 0.0),
+    glam::Vec4::new(0.0, -1.0, 0.0, 0.0),
+    glam::Vec4::W,
+);
+
 /// Blender's Window texture coordinates of world points (Cycles' `camera_world_to_ndc`): the
 /// camera frame's `[0, 1]²`, `(0, 0)` at its bottom-left corner, lens shift included, `z = 0`.
 /// The frame's aspect follows the resolution of the latest render
@@ -323,14 +331,8 @@ impl WindowMap {
             Projection::Panoramic(_) => (None, 1.0),
         };
         // Shading points are in Blender's world (Z up); the camera is in glTF's (Y up).
-        let blender = Mat4::from_cols(
-            glam::Vec4::X,
-            glam::Vec4::new(0.0, 0.0, 1.0, 0.0),
-            glam::Vec4::new(0.0, -1.0, 0.0, 0.0),
-            glam::Vec4::W,
-        );
         WindowMap {
-            world_to_camera: (blender * cam.to_world).inverse(),
+            world_to_camera: (GLTF_TO_BLENDER * cam.to_world).inverse(),
             perspective,
             fitted,
             fit: cam.fit,

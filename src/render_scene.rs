@@ -411,13 +411,7 @@ const MAX_HIDDEN_SKIPS: usize = 64;
 /// The camera in Blender's coordinates (for the graph's Camera coordinates).
 fn blender_camera_to_world(scene: &Scene) -> Mat4 {
     scene.camera.map_or(Mat4::IDENTITY, |c| {
-        let b = Mat4::from_cols(
-            glam::Vec4::X,
-            glam::Vec4::new(0.0, 0.0, 1.0, 0.0),
-            glam::Vec4::new(0.0, -1.0, 0.0, 0.0),
-            glam::Vec4::W,
-        );
-        b * c.to_world
+        crate::camera::GLTF_TO_BLENDER * c.to_world
     })
 }
 

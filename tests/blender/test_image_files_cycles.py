@@ -66,14 +66,9 @@ def _load(path, pack=False):
     return img
 
 
-def textured_plane(tmp_path, name, pack=False):
-    """An emissive plane showing a magnified 8x8 texture from the file `name`, filling the view."""
-    scenes.clear_scene()
-    path = tmp_path / name
-    _write(path, _checker())
-    img = _load(path, pack)
-    assert img.is_float == (not name.endswith("8.png")), "the file loads as the test means"
-    mat = bpy.data.materials.new("Shown")
+def _shown(img, name):
+    """An emission material showing `img` (linear interpolation)."""
+    mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     nt = mat.node_tree
     nt.nodes.remove(nt.nodes["Principled BSDF"])
@@ -82,6 +77,17 @@ def textured_plane(tmp_path, name, pack=False):
     em = nt.nodes.new("ShaderNodeEmission")
     nt.links.new(tex.outputs["Color"], em.inputs["Color"])
     nt.links.new(em.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+    return mat
+
+
+def textured_plane(tmp_path, name, pack=False):
+    """An emissive plane showing a magnified 8x8 texture from the file `name`, filling the view."""
+    scenes.clear_scene()
+    path = tmp_path / name
+    _write(path, _checker())
+    img = _load(path, pack)
+    assert img.is_float == (not name.endswith("8.png")), "the file loads as the test means"
+    mat = _shown(img, "Shown")
     scenes.add_quad("Plane", [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], mat)
     scenes.add_camera((0.0, 0.0, 2.2), (0.0, 0.0, 0.0), fov=math.radians(50.0))
     return scenes.SceneInfo(bpy.context.scene, "textured_plane")
@@ -153,15 +159,7 @@ def udim_plane(tmp_path, kinds, pack=False):
     assert [t.number for t in img.tiles] == list(numbers), "Blender finds the tiles"
     if pack:
         img.pack()
-    mat = bpy.data.materials.new("Skin")
-    mat.use_nodes = True
-    nt = mat.node_tree
-    nt.nodes.remove(nt.nodes["Principled BSDF"])
-    tex = nt.nodes.new("ShaderNodeTexImage")
-    tex.image, tex.interpolation = img, "Linear"
-    em = nt.nodes.new("ShaderNodeEmission")
-    nt.links.new(tex.outputs["Color"], em.inputs["Color"])
-    nt.links.new(em.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+    mat = _shown(img, "Skin")
     bpy.ops.mesh.primitive_grid_add(x_subdivisions=11, y_subdivisions=11, size=2.0)
     grid = bpy.context.active_object
     grid.data.materials.append(mat)
