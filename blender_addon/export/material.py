@@ -170,6 +170,7 @@ def convert_material(material, warnings, textures=None):
 _GROUP_TYPES = ("ShaderNodeGroup", "NodeGroup", "ShaderNodeCustomGroup")
 _SIMPLE_PROP_TYPES = ("ENUM", "BOOLEAN", "INT", "FLOAT", "STRING")
 _SKIP_PROPS = {"bytecode", "bytecode_hash"}  # a Script node's compiled OSL: large, of no use
+MENU_SWITCH = "GeometryNodeMenuSwitch"  # shader trees use it too (Blender 4.5+)
 _MAX_DEPTH = 400           # link hops from the output; Blender forbids cycles, this guards anyway
 _base_props = None
 
@@ -339,6 +340,8 @@ class MaterialGraph:
                 if il.to_socket.identifier == sock.identifier and compat.socket_available(il.from_socket):
                     return self._input(ctx, il.from_socket, depth)
             return _zero(sock.type)
+        if kind == MENU_SWITCH:
+            return self._menu_switch(ctx, node, sock, depth)
         if kind == "NodeGroupInput":
             if not ctx:
                 return _zero(sock.type)
@@ -367,6 +370,56 @@ class MaterialGraph:
             return None
         target = moved.get(sock.identifier, [idx, sock.identifier])
         return {"link": [target[0], target[1]]}
+
+    def _menu_switch(self, ctx, node, sock, depth):
+        """A Menu Switch passes on the input of the item its menu selects (Blender resolves the
+        menu when it compiles the tree: it is a constant, from the node or a group's input);
+        its per-item outputs are true for the selected item."""
+        chosen = self._menu_choice(ctx, node, depth)
+        if sock.identifier != "Output":
+            return chosen is not None and sock.name == chosen.name
+        if chosen is None:
+            return _zero(sock.type)
+        return self._input(ctx, chosen, depth)
+
+    def _menu_choice(self, ctx, node, depth):
+        """The item input a Menu Switch selects in group context `ctx`, or None (reported)."""
+        menu = next((s for s in node.inputs if s.type == "MENU"), None)
+        name = self._menu_value(ctx, menu, depth) if menu is not None else None
+        for s in node.inputs:
+            if s.type not in ("MENU", "CUSTOM") and s.name == name and compat.socket_available(s):
+                return s
+        self.report(self.name, node, "the menu's item could not be found; its output is zero")
+        return None
+
+    def _menu_value(self, ctx, sock, depth):
+        """The item name a menu socket carries: its own value, or what a reroute, a group's
+        input or output, or another Menu Switch passes into it."""
+        link = self._link_into(sock)
+        if link is None:
+            return getattr(sock, "default_value", None)
+        if depth > _MAX_DEPTH:
+            return None
+        node, out = link.from_node, link.from_socket
+        kind = node.bl_idname
+        if kind == "NodeReroute":
+            return self._menu_value(ctx, node.inputs[0], depth + 1)
+        if kind == "NodeGroupInput":
+            outer = next((s for s in ctx[-1].inputs if s.identifier == out.identifier),
+                         None) if ctx else None
+            return self._menu_value(ctx[:-1], outer, depth + 1) if outer is not None else None
+        if kind == MENU_SWITCH and out.identifier == "Output":
+            chosen = self._menu_choice(ctx, node, depth + 1)
+            return self._menu_value(ctx, chosen, depth + 1) if chosen is not None else None
+        tree = getattr(node, "node_tree", None)
+        if tree is not None:
+            gout = next((n for n in tree.nodes if n.bl_idname == "NodeGroupOutput"
+                         and getattr(n, "is_active_output", True)), None)
+            inner = next((s for s in gout.inputs if s.identifier == out.identifier),
+                         None) if gout is not None else None
+            if inner is not None:
+                return self._menu_value(ctx + (node,), inner, depth + 1)
+        return None
 
     # -- node export ----------------------------------------------------------------------------
 

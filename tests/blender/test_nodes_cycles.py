@@ -1250,6 +1250,42 @@ def group_snapped_case(g):
 case("node_group-snapped", group_snapped_case, offset=1.0)
 
 
+def menu_switch_case(g):
+    """Menu Switches as node groups use them: a group whose Menu input picks one of three
+    items (a noise, a linked field, a constant colour), set to the second by the group node,
+    and a switch on the node itself whose per-item boolean output scales the result."""
+    grp = bpy.data.node_groups.new("Pick", "ShaderNodeTree")
+    grp.interface.new_socket("Vector", in_out="INPUT", socket_type="NodeSocketVector")
+    grp.interface.new_socket("Mode", in_out="INPUT", socket_type="NodeSocketMenu")
+    grp.interface.new_socket("Color", in_out="OUTPUT", socket_type="NodeSocketColor")
+    gin = grp.nodes.new("NodeGroupInput")
+    gout = grp.nodes.new("NodeGroupOutput")
+    sw = grp.nodes.new("GeometryNodeMenuSwitch")
+    sw.data_type = "RGBA"
+    sw.enum_items[0].name, sw.enum_items[1].name = "Noise", "Field"
+    sw.enum_items.new("Flat")
+    noise = grp.nodes.new("ShaderNodeTexNoise")
+    grp.links.new(gin.outputs["Vector"], noise.inputs["Vector"])
+    grp.links.new(noise.outputs["Color"], sw.inputs["Noise"])
+    grp.links.new(gin.outputs["Vector"], sw.inputs["Field"])
+    sw.inputs["Flat"].default_value = (0.9, 0.1, 0.1, 1.0)
+    grp.links.new(gin.outputs["Mode"], sw.inputs["Menu"])
+    grp.links.new(sw.outputs["Output"], gout.inputs["Color"])
+    node = g.new("ShaderNodeGroup")
+    node.node_tree = grp
+    g.set(node, "Vector", g.vmath("ABSOLUTE", P3(g)))
+    node.inputs["Mode"].default_value = "Field"
+    gate = g.new("GeometryNodeMenuSwitch", {"data_type": "FLOAT"})
+    gate.inputs["Menu"].default_value = "B"
+    on = g.math("MULTIPLY_ADD", gate.outputs["B"], 0.5, 0.25)
+    return g.out(g.new("ShaderNodeMix", {"data_type": "RGBA", "blend_type": "MULTIPLY"},
+                       Factor_Float=1.0, A_Color=g.out(node), B_Color=g.comb(on, on, on)),
+                 "Result_Color")
+
+
+case("menu_switch", menu_switch_case)
+
+
 def muted_case(kind):
     def build(g):
         if kind == "math":
