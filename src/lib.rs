@@ -8,6 +8,7 @@ pub mod accel;
 pub mod bsdf;
 pub mod camera;
 pub mod denoise;
+pub mod displace;
 pub mod emitter;
 pub mod film;
 pub mod frame;

@@ -574,6 +574,12 @@ impl RenderScene {
     pub fn new(mut scene: Scene, choice: LightChoice) -> RenderScene {
         let (programs, mut warnings) = compile_programs(&scene);
         bake_emissive_instances(&mut scene, &programs);
+        let to_world = blender_camera_to_world(&scene);
+        for w in crate::displace::displace_meshes(&mut scene, to_world) {
+            if !warnings.contains(&w) {
+                warnings.push(w);
+            }
+        }
         // Triangles go straight from the meshes into the builder: no copy of the scene at the
         // build's peak memory.
         let placed = scene.placed_meshes();

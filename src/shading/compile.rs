@@ -8,9 +8,10 @@
 //! evaluates a muted node (its internal links, else zero) and reported once in `warnings`,
 //! naming the material and the node.
 
+use super::globals::{ShadeEnv, ShaderGlobals};
 use super::graph::{Graph, Input};
 use super::nodes;
-use super::program::{Op, Program, Slot};
+use super::program::{Op, Program, Scratch, Slot};
 use glam::Vec3;
 use serde_json::Value;
 use std::collections::HashMap;
@@ -92,7 +93,11 @@ pub struct Compiled {
 pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, CompileError> {
     let mut c = Compiler::new(graph, material, false);
     if let Some((node, output)) = &graph.displacement {
-        c.displacement_as_bump(*node, output)?;
+        // True displacement alone moves the vertices (see [`compile_displacement`]) and leaves
+        // the normal to the displaced geometry; "Displacement and Bump" adds the bump.
+        if graph.displacement_method != "DISPLACEMENT" {
+            c.displacement_as_bump(*node, output)?;
+        }
     }
     if let Some((node, output)) = &graph.surface {
         let one = c.constant(&[1.0])?;
@@ -134,6 +139,46 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
     let mut warnings = c.warnings;
     warnings.extend(volume_warnings);
     Ok(Compiled { program, warnings })
+}
+
+/// A material's true displacement (Cycles' methods "Displacement Only" and "Displacement and
+/// Bump"): run at a mesh vertex, `program` leaves the displacement vector of the material
+/// output's Displacement (Blender world space, metres) in slot `out`.
+pub struct Displacer {
+    pub program: Program,
+    pub out: Slot,
+}
+
+impl Displacer {
+    /// The displacement at `g` (Blender world space); zero where it is not finite.
+    pub fn at(&self, g: &ShaderGlobals, env: &ShadeEnv, scratch: &mut Scratch) -> Vec3 {
+        self.program.run(g, env, scratch);
+        let o = self.out as usize;
+        let d = Vec3::new(scratch.slots[o], scratch.slots[o + 1], scratch.slots[o + 2]);
+        if d.is_finite() { d } else { Vec3::ZERO }
+    }
+}
+
+/// The program that moves the vertices of meshes with `graph`'s material, when its
+/// displacement method displaces them (`None` for "Bump Only" and without a Displacement).
+pub fn compile_displacement(
+    graph: &Graph,
+    material: &str,
+) -> std::result::Result<Option<Displacer>, CompileError> {
+    let Some((node, output)) = &graph.displacement else {
+        return Ok(None);
+    };
+    if !matches!(graph.displacement_method.as_str(), "DISPLACEMENT" | "BOTH") {
+        return Ok(None);
+    }
+    let mut c = Compiler::new(graph, material, false);
+    let out = c.link(*node, output, SocketType::Vector)?;
+    let program = Program {
+        ops: c.ops,
+        init: c.init,
+        ..Program::default()
+    };
+    Ok(Some(Displacer { program, out }))
 }
 
 /// The medium of the volume `(node, output)` feeds into the material output's Volume, and what
@@ -194,18 +239,9 @@ impl<'g> Compiler<'g> {
 
     /// The material output's Displacement as Cycles' "Bump Only": the displacement vector at
     /// the point and its two offsets, the displaced normal from them, and a Set Normal that
-    /// the surface graph (compiled afterwards, from scratch) sees as `N`. True displacement of
-    /// the vertices is not rendered: reported.
+    /// the surface graph (compiled afterwards, from scratch) sees as `N`. With "Displacement
+    /// and Bump" the vertices are displaced as well ([`compile_displacement`]).
     fn displacement_as_bump(&mut self, node: usize, output: &str) -> Result<()> {
-        let method = self.graph.displacement_method.as_str();
-        if method != "BUMP" {
-            let n = &self.graph.nodes[node];
-            self.warn(format!(
-                "material '{}': displacement method {method} from node '{}' ({}): the vertices are \
-                 not displaced, the displacement is rendered as bump only",
-                self.material, n.name, n.kind
-            ));
-        }
         let center = self.link(node, output, SocketType::Vector)?;
         let mut d = [center; 3];
         for axis in [1u8, 2] {

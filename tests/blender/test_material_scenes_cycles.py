@@ -308,6 +308,49 @@ def displacement_bump():
     _floor_stage(mat, sun_dir=(-1.0, 0.4, -0.35), sun=5.0, world_strength=0.05)
 
 
+def true_displacement_terrain(method):
+    """A 160 x 160 grid whose vertices a Noise (object space, scale 0.35) displaces along the
+    normal ("DISPLACEMENT": the normals come from the moved triangles; "BOTH": the bump of the
+    same displacement shades it), a rough Principled BSDF under a low sun that throws the
+    hills' shadows."""
+    mat, nt, out = node_material("Terrain")
+    tc = node(nt, "ShaderNodeTexCoord")
+    noise = node(nt, "ShaderNodeTexNoise", Vector=tc.outputs["Object"], Scale=1.2, Detail=3.0)
+    disp = node(nt, "ShaderNodeDisplacement", Height=noise.outputs["Fac"], Midlevel=0.5,
+                Scale=0.35)
+    principled(nt, out, Base_Color=(0.6, 0.55, 0.45, 1.0), Roughness=0.6)
+    _displacement_output(mat, nt, out, disp)
+    mat.displacement_method = method
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=160, y_subdivisions=160, size=4.0)
+    ob = bpy.context.active_object
+    ob.data.materials.append(mat)
+    scenes.add_sun_light("Sun", (-1.0, 0.4, -0.35), 5.0)
+    world(0.1)
+    scenes.add_camera((0.0, -3.4, 2.4), (0.0, 0.0, 0.0), fov=math.radians(45.0))
+
+
+def true_displacement_ball():
+    """A smooth UV sphere (its UV seam splits vertices) displaced along its normals by a Wave
+    texture's Fac (scale 0.12, Displacement Only): the seam must not crack, and the shading
+    follows the normals of the moved triangles."""
+    lit_floor((-0.5, 0.6, -0.8), (0.0, 0.0, 0.75))
+    mat, nt, out = node_material("Ridged")
+    tc = node(nt, "ShaderNodeTexCoord")
+    wave = node(nt, "ShaderNodeTexWave", Vector=tc.outputs["Object"], Scale=2.5)
+    disp = node(nt, "ShaderNodeDisplacement", Height=wave.outputs["Fac"], Midlevel=0.0,
+                Scale=0.12)
+    surface(nt, out, node(nt, "ShaderNodeBsdfDiffuse", Color=(0.7, 0.7, 0.7, 1.0)).outputs[0])
+    _displacement_output(mat, nt, out, disp)
+    mat.displacement_method = "DISPLACEMENT"
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=0.6,
+                                         location=(0.0, 0.0, 0.75))
+    ob = bpy.context.active_object
+    ob.rotation_euler = (0.0, 0.0, math.radians(200.0))  # the seam faces the camera
+    ob.data.materials.append(mat)
+    ob.data.polygons.foreach_set("use_smooth", [True] * len(ob.data.polygons))
+    ob.data.update()
+
+
 def vector_displacement_ball(vector=True):
     """A Wave texture's colour as a world-space Vector Displacement of a ball (only its normal
     component bumps; `vector` False: its Fac through an object-space Displacement node),
@@ -1089,6 +1132,9 @@ CASES = [
     ("noise_bump", noise_bump, 0, 128, 512),
     ("displacement_bump_noise", displacement_bump, 0, 128, 512),
     ("vector_displacement_ball", vector_displacement_ball, 0, 128, 512),
+    ("true_displacement_terrain", lambda: true_displacement_terrain("DISPLACEMENT"), 0, 128, 512),
+    ("true_displacement_and_bump", lambda: true_displacement_terrain("BOTH"), 0, 128, 512),
+    ("true_displacement_ball_seam", true_displacement_ball, 0, 128, 512),
     ("displacement_wave_ball", lambda: vector_displacement_ball(False), 0, 128, 512),
     ("image_box_projection", projected_image("BOX"), 0, 64, 256),
     ("image_sphere_projection_cubic", projected_image("SPHERE", "Cubic", "Generated"), 0, 64, 256),
