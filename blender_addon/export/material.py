@@ -199,6 +199,26 @@ def _zero(sock_type):
     return None
 
 
+def _is_group(node):
+    kind = node.bl_idname
+    return kind in _GROUP_TYPES or (getattr(node, "node_tree", None) is not None
+                                    and kind.endswith("Group"))
+
+
+def _group_output_socket(group, out):
+    """The socket inside `group`'s tree that its output `out` passes on: on the active Group
+    Output (else the first), None without one."""
+    tree = getattr(group, "node_tree", None)
+    if tree is None:
+        return None
+    gouts = [n for n in tree.nodes if n.bl_idname == "NodeGroupOutput"]
+    gout = next((n for n in gouts if getattr(n, "is_active_output", False)), None)
+    gout = gout or (gouts[0] if gouts else None)
+    if gout is None:
+        return None
+    return next((s for s in gout.inputs if s.identifier == out.identifier), None)
+
+
 def _rows(m):
     return [[float(v) for v in row] for row in m]
 
@@ -350,18 +370,11 @@ class MaterialGraph:
             if outer is None:
                 return _zero(sock.type)
             return self._input(ctx[:-1], outer, depth)
-        if kind in _GROUP_TYPES or (getattr(node, "node_tree", None) is not None
-                                    and kind.endswith("Group")):
-            tree = getattr(node, "node_tree", None)
-            if tree is None:
+        if _is_group(node):
+            if getattr(node, "node_tree", None) is None:
                 self.report(self.name, node, "node group without a node tree; its outputs are zero")
                 return _zero(sock.type)
-            gouts = [n for n in tree.nodes if n.bl_idname == "NodeGroupOutput"]
-            gout = next((n for n in gouts if getattr(n, "is_active_output", False)), None)
-            gout = gout or (gouts[0] if gouts else None)
-            if gout is None:
-                return _zero(sock.type)
-            inner = next((s for s in gout.inputs if s.identifier == sock.identifier), None)
+            inner = _group_output_socket(node, sock)
             if inner is None:
                 return _zero(sock.type)
             return self._input(ctx + (node,), inner, depth)
@@ -411,14 +424,9 @@ class MaterialGraph:
         if kind == MENU_SWITCH and out.identifier == "Output":
             chosen = self._menu_choice(ctx, node, depth + 1)
             return self._menu_value(ctx, chosen, depth + 1) if chosen is not None else None
-        tree = getattr(node, "node_tree", None)
-        if tree is not None:
-            gout = next((n for n in tree.nodes if n.bl_idname == "NodeGroupOutput"
-                         and getattr(n, "is_active_output", True)), None)
-            inner = next((s for s in gout.inputs if s.identifier == out.identifier),
-                         None) if gout is not None else None
-            if inner is not None:
-                return self._menu_value(ctx + (node,), inner, depth + 1)
+        inner = _group_output_socket(node, out) if _is_group(node) else None
+        if inner is not None:
+            return self._menu_value(ctx + (node,), inner, depth + 1)
         return None
 
     # -- node export ----------------------------------------------------------------------------
