@@ -15,8 +15,8 @@
 //! - Meshes placed by instances (object space) are not displaced: reported.
 
 use crate::scene::{Mesh, Scene};
-use crate::shading::compile::{Displacer, compile_displacement};
-use crate::shading::globals::{ShadeEnv, ShaderGlobals, from_blender};
+use crate::shading::compile::{CompileError, Displacer, compile_displacement};
+use crate::shading::globals::{ShadeEnv, ShaderGlobals, from_blender, to_blender};
 use crate::shading::program::with_scratch;
 use glam::{Mat4, Vec2, Vec3};
 use std::collections::HashMap;
@@ -24,23 +24,26 @@ use std::collections::HashMap;
 /// Displaces the world-space meshes of `scene` whose material asks for it; returns what could
 /// not be displaced, one line per material.
 pub fn displace_meshes(scene: &mut Scene, camera_to_world: Mat4) -> Vec<String> {
+    let mut warnings = Vec::new();
     let displacers: Vec<Option<Displacer>> = (scene.materials.iter())
-        .map(|m| {
-            let g = m.graph.as_ref()?;
-            compile_displacement(g, &m.name).ok().flatten()
+        .map(|m| match compile_displacement(m.graph.as_ref()?, &m.name) {
+            Ok(d) => d,
+            Err(CompileError(e)) => {
+                warnings.push(format!("{e}; the vertices are not displaced"));
+                None
+            }
         })
         .collect();
-    let mut warnings = Vec::new();
     if displacers.iter().all(Option::is_none) {
         return warnings;
     }
     let placed = scene.placed_meshes();
-    let only = |m: usize| {
-        scene.materials[m]
-            .graph
-            .as_ref()
-            .map(|g| g.displacement_method.as_str())
-            == Some("DISPLACEMENT")
+    let env = ShadeEnv {
+        images: &scene.images,
+        textures: &scene.textures,
+        camera_to_world,
+        window: &crate::camera::NO_WINDOW,
+        tracer: None,
     };
     let mut moved = Vec::new();
     for (mi, mesh) in scene.meshes.iter().enumerate() {
@@ -49,27 +52,25 @@ pub fn displace_meshes(scene: &mut Scene, camera_to_world: Mat4) -> Vec<String> 
         };
         if placed[mi] {
             let msg = format!(
-                "material '{}': mesh '{}' is instanced; its vertices are not displaced (the \
-                 displacement renders as bump only)",
-                scene.materials[mesh.material].name, mesh.name
+                "material '{}': mesh '{}' is instanced; its vertices are not displaced ({})",
+                scene.materials[mesh.material].name,
+                mesh.name,
+                if d.renormal {
+                    "Displacement Only: the displacement is not rendered"
+                } else {
+                    "only the bump of Displacement and Bump renders"
+                }
             );
             if !warnings.contains(&msg) {
                 warnings.push(msg);
             }
             continue;
         }
-        let env = ShadeEnv {
-            images: &scene.images,
-            textures: &scene.textures,
-            camera_to_world,
-            window: &crate::camera::NO_WINDOW,
-            tracer: None,
-        };
-        moved.push((mi, vertex_offsets(mesh, d, &env), only(mesh.material)));
+        moved.push((mi, vertex_offsets(mesh, d, &env), d.renormal));
     }
-    for (mi, offsets, recompute) in moved {
+    for (mi, offsets, renormal_after) in moved {
         let mesh = &mut scene.meshes[mi];
-        let before = recompute.then(|| mesh.positions.clone());
+        let before = renormal_after.then(|| mesh.positions.clone());
         for (p, d) in mesh.positions.iter_mut().zip(&offsets) {
             *p += *d;
         }
@@ -103,7 +104,7 @@ fn vertex_offsets(mesh: &Mesh, d: &Displacer, env: &ShadeEnv) -> Vec<Vec3> {
                     let n = mesh.shading_normal(tri as u32, bc.x, bc.y).unwrap_or(ng);
                     let uv = mesh.uvs.get(vi).copied().unwrap_or(Vec2::ZERO);
                     let mut g = ShaderGlobals::at(p, n, uv);
-                    g.ng = crate::shading::globals::to_blender(ng);
+                    g.ng = to_blender(ng);
                     g.ray_flags = 0;
                     g.mesh = Some(mesh);
                     g.tri = tri as u32;

@@ -11,7 +11,7 @@
 use super::globals::{ShadeEnv, ShaderGlobals};
 use super::graph::{Graph, Input};
 use super::nodes;
-use super::program::{Op, Program, Scratch, Slot};
+use super::program::{Op, Program, Scratch, Slot, Slots};
 use glam::Vec3;
 use serde_json::Value;
 use std::collections::HashMap;
@@ -147,14 +147,16 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
 pub struct Displacer {
     pub program: Program,
     pub out: Slot,
+    /// "Displacement Only": the normals come from the moved geometry (else the bump of the
+    /// surface program perturbs the interpolated ones).
+    pub renormal: bool,
 }
 
 impl Displacer {
     /// The displacement at `g` (Blender world space); zero where it is not finite.
     pub fn at(&self, g: &ShaderGlobals, env: &ShadeEnv, scratch: &mut Scratch) -> Vec3 {
         self.program.run(g, env, scratch);
-        let o = self.out as usize;
-        let d = Vec3::new(scratch.slots[o], scratch.slots[o + 1], scratch.slots[o + 2]);
+        let d = Slots(&mut scratch.slots).v(self.out);
         if d.is_finite() { d } else { Vec3::ZERO }
     }
 }
@@ -168,9 +170,11 @@ pub fn compile_displacement(
     let Some((node, output)) = &graph.displacement else {
         return Ok(None);
     };
-    if !matches!(graph.displacement_method.as_str(), "DISPLACEMENT" | "BOTH") {
-        return Ok(None);
-    }
+    let renormal = match graph.displacement_method.as_str() {
+        "DISPLACEMENT" => true,
+        "BOTH" => false,
+        _ => return Ok(None),
+    };
     let mut c = Compiler::new(graph, material, false);
     let out = c.link(*node, output, SocketType::Vector)?;
     let program = Program {
@@ -178,7 +182,11 @@ pub fn compile_displacement(
         init: c.init,
         ..Program::default()
     };
-    Ok(Some(Displacer { program, out }))
+    Ok(Some(Displacer {
+        program,
+        out,
+        renormal,
+    }))
 }
 
 /// The medium of the volume `(node, output)` feeds into the material output's Volume, and what
