@@ -14,6 +14,7 @@ use tesela::bsdf::microfacet::{
     anisotropy, ggx_d, ggx_d_aniso, ggx_g1, ggx_g1_aniso, sample_visible_normal,
     sample_visible_normal_aniso,
 };
+use tesela::bsdf::thin_film::ThinFilm;
 use tesela::bsdf::{
     Bsdf, BsdfQueryRecord, Coat, ConductorFresnel, Dielectric, Diffuse, Layered, Measure, Mirror,
     Plastic, RoughConductor, RoughDielectric, Sheen, Toon, Translucent, Transparent,
@@ -1405,6 +1406,12 @@ fn rough_dielectric_sampling() {
         (
             "aniso reflection-only 1.5 ax=0.4 ay=0.1",
             RoughDielectric::reflection(tint, 1.5, 0.4, 0.1),
+        ),
+        (
+            // A coloured film makes the reflect/refract choice differ per channel.
+            "principled 1.5 a=0.2 under a 380 nm film",
+            RoughDielectric::principled_transmission(tint, Vec3::ONE, 1.5, 0.2)
+                .with_thin_film(ThinFilm::new(380.0, 1.33)),
         ),
     ];
     let thetas = [0.0f64, 60.0, 87.0, -30.0, -70.0];

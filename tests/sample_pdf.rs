@@ -6,6 +6,7 @@
 
 use glam::{Vec2, Vec3};
 use tesela::bsdf::microfacet::anisotropy;
+use tesela::bsdf::thin_film::ThinFilm;
 use tesela::bsdf::{
     BaseLobe, Bsdf, BsdfInstance, BsdfQueryRecord, Coat, ConductorFresnel, Dielectric, Diffuse,
     Layered, Measure, Mirror, Plastic, RoughConductor, RoughDielectric, Sheen, SurfaceParams, Toon,
@@ -252,6 +253,22 @@ fn blender_lobes_sample_pdf_and_weight_agree() {
             format!("Principled transmission ior={ior} alpha={alpha}"),
             &RoughDielectric::principled_transmission(c, Vec3::new(1.0, 0.2, 0.5), ior, alpha),
             true,
+        );
+        run(
+            format!("Principled transmission under a film ior={ior} alpha={alpha}"),
+            &RoughDielectric::principled_transmission(c, Vec3::new(1.0, 0.2, 0.5), ior, alpha)
+                .with_thin_film(ThinFilm::new(450.0, 1.4)),
+            true,
+        );
+        run(
+            format!("specular over diffuse under a film ior={ior} alpha={alpha}"),
+            &Layered::new(
+                RoughDielectric::principled_specular(c, ior, alpha, alpha)
+                    .with_thin_film(ThinFilm::new(250.0, 1.8))
+                    .multiscatter(),
+                Diffuse::new(c),
+            ),
+            false,
         );
         run(
             format!("Refraction ior={ior} alpha={alpha}"),

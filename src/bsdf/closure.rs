@@ -210,6 +210,7 @@ pub fn from_closure_without_caustics(
                     let alpha = q.roughness.clamp(0.0, 1.0).powi(2);
                     return Some(BsdfInstance::RoughDielectric(
                         RoughDielectric::principled_specular(q.specular_tint, q.ior, alpha, alpha)
+                            .with_thin_film(q.thin_film)
                             .multiscatter()
                             .blurred(blur),
                     ));
@@ -258,14 +259,17 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
     let transmission = p.transmission.clamp(0.0, 1.0) * (1.0 - metallic);
     let base = if u < transmission {
         if alpha < DELTA_ALPHA {
-            BaseLobe::Dielectric(Dielectric::new(p.ior, p.base_color))
+            BaseLobe::Dielectric(
+                Dielectric::new(p.ior, p.base_color).with_thin_film(p.thin_film, p.specular_tint),
+            )
         } else {
             let l = RoughDielectric::principled_transmission(
                 p.base_color,
                 p.specular_tint,
                 p.ior,
                 alpha0,
-            );
+            )
+            .with_thin_film(p.thin_film);
             BaseLobe::RoughDielectric(if ms { l.multiscatter() } else { l }.blurred(blur))
         }
     } else {
@@ -287,17 +291,21 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
         } else if !principled_has_specular(p) {
             BaseLobe::Diffuse(rough_diffuse(diffuse))
         } else if ax.max(ay) < DELTA_ALPHA {
-            BaseLobe::Plastic(Plastic::cycles(
-                diffuse,
-                alpha,
-                principled_specular_ior(p.ior, p.specular_level),
-                p.specular_tint,
-            ))
+            BaseLobe::Plastic(
+                Plastic::cycles(
+                    diffuse,
+                    alpha,
+                    principled_specular_ior(p.ior, p.specular_level),
+                    p.specular_tint,
+                )
+                .with_thin_film(p.thin_film),
+            )
         } else {
             // Cycles: a GGX reflection with the Fresnel of the level-adjusted IOR over the
             // diffuse base, which keeps what the specular layer's albedo leaves.
             let ior = principled_specular_ior(p.ior, p.specular_level);
-            let specular = RoughDielectric::principled_specular(p.specular_tint, ior, ax0, ay0);
+            let specular = RoughDielectric::principled_specular(p.specular_tint, ior, ax0, ay0)
+                .with_thin_film(p.thin_film);
             let specular = if ms_aniso {
                 specular.multiscatter()
             } else {
@@ -330,11 +338,11 @@ fn principled(p: &Principled, u: f32, blur: f32) -> BsdfInstance {
 }
 
 /// Whether the Principled BSDF's dielectric base has its specular layer: as in Cycles, unless
-/// the level-adjusted IOR is 1 (Specular IOR Level 0, or IOR 1). A black Specular Tint keeps
-/// the layer: it scales `F0` only, and grazing reflection stays white.
+/// the level-adjusted IOR is 1 (Specular IOR Level 0, or IOR 1) and there is no thin film. A
+/// black Specular Tint keeps the layer: it scales `F0` only, and grazing reflection stays white.
 #[inline]
 pub fn principled_has_specular(p: &Principled) -> bool {
-    principled_specular_ior(p.ior, p.specular_level) != 1.0
+    principled_specular_ior(p.ior, p.specular_level) != 1.0 || p.thin_film.is_some()
 }
 
 /// `A(wi)`: the share of light arriving from the local direction `wi` (above the closure's
@@ -350,7 +358,8 @@ pub fn principled_base_attenuation(p: &Principled, wi: Vec3) -> Vec3 {
     if principled_has_specular(p) {
         let ior = principled_specular_ior(p.ior, p.specular_level);
         let (ax, ay) = (ax.max(DELTA_ALPHA), ay.max(DELTA_ALPHA));
-        let specular = RoughDielectric::principled_specular(p.specular_tint, ior, ax, ay);
+        let specular = RoughDielectric::principled_specular(p.specular_tint, ior, ax, ay)
+            .with_thin_film(p.thin_film);
         let specular = if p.multiscatter {
             specular.multiscatter()
         } else {

@@ -153,7 +153,10 @@ impl Layer for RoughDielectric {
         // Cycles finds the albedo when it sets the closure up, before any Filter Glossy.
         let r = &self.setup_roughness;
         let alpha = (r.alpha_x * r.alpha_y).sqrt();
-        let f = if self.f0_tint == Vec3::ONE {
+        let f = if let Some(film) = &self.thin_film {
+            // No table holds a film's albedo: Cycles takes the reflectance along the normal.
+            self.film_reflectance(film, mu, self.ior)
+        } else if self.f0_tint == Vec3::ONE {
             Vec3::splat(dielectric_reflection_albedo(alpha, mu, self.ior))
         } else {
             let f0 = (fresnel::f0_from_ior(self.ior) * self.f0_tint).min(Vec3::ONE);

@@ -17,6 +17,7 @@ pub mod plastic;
 pub mod rough_dielectric;
 pub mod sheen;
 pub mod tables;
+pub mod thin_film;
 pub mod toon;
 pub mod translucent;
 pub mod transparent;

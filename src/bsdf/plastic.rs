@@ -7,6 +7,7 @@
 //! coat with probability `max F(wi)`; `pdf` is the matching mixture density.
 
 use super::microfacet::{ggx_d, ggx_g2, reflection_pdf, sample_reflection};
+use super::thin_film::ThinFilm;
 use super::{Bsdf, BsdfQueryRecord, DELTA_ALPHA, Measure, fresnel};
 use crate::sampling::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
 use glam::{Vec2, Vec3};
@@ -29,6 +30,13 @@ pub enum CoatFresnel {
     /// (1 - F0)` with `F` the exact dielectric reflectance and `F0 = F0(η)`; a black tint keeps
     /// the white grazing reflection.
     Cycles { eta: f32, f0: f32, f0_tint: Vec3 },
+    /// [`CoatFresnel::Cycles`] under a thin film: the film's reflectance with `F0` scaled
+    /// by the tint ([`ThinFilm::principled`]).
+    Film {
+        eta: f32,
+        f0_tint: Vec3,
+        film: ThinFilm,
+    },
 }
 
 impl Plastic {
@@ -66,12 +74,26 @@ impl Plastic {
         }
     }
 
+    /// The same layer under a thin film (`None`: unchanged); a Cycles layer only.
+    pub fn with_thin_film(self, film: Option<ThinFilm>) -> Self {
+        match (self.fresnel, film) {
+            (CoatFresnel::Cycles { eta, f0_tint, .. }, Some(film)) => Plastic {
+                fresnel: CoatFresnel::Film { eta, f0_tint, film },
+                ..self
+            },
+            _ => self,
+        }
+    }
+
     /// The coat's reflectance `F(cos θi)` per channel.
     #[inline]
     pub fn coat_fresnel(&self, cos_i: f32) -> Vec3 {
         match self.fresnel {
             CoatFresnel::Schlick { f0, specular, tint } => {
                 specular * fresnel::schlick1(f0, cos_i) * tint
+            }
+            CoatFresnel::Film { eta, f0_tint, film } => {
+                film.principled(cos_i.clamp(0.0, 1.0), eta, film.ior, f0_tint)
             }
             CoatFresnel::Cycles { eta, f0, f0_tint } => {
                 let s = if f0 < 1.0 {

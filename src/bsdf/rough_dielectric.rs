@@ -27,6 +27,7 @@
 //! glass, the average Fresnel for reflection).
 
 use super::microfacet::Roughness;
+use super::thin_film::ThinFilm;
 use super::{Bsdf, BsdfQueryRecord, Measure, fresnel, tables};
 use glam::{Vec2, Vec3};
 
@@ -65,6 +66,9 @@ pub struct RoughDielectric {
     /// `(cos θi, η, energy_factor, E(cos θi))` found once for the shading point's incident
     /// direction (`E` from the table the factor came from).
     energy_at: Option<(f32, f32, Vec3, f32)>,
+    /// A thin film on the surface (the Principled BSDF's): its interference replaces the
+    /// Fresnel reflectance of reflection and glass modes ([`ThinFilm::principled`]).
+    pub thin_film: Option<ThinFilm>,
 }
 
 /// Relative index within this distance of 1 makes refraction a pass-through (Cycles treats it
@@ -99,7 +103,27 @@ impl RoughDielectric {
             transmission_tint: transmission_tint.max(Vec3::ZERO),
             multiscatter_fss: None,
             energy_at: None,
+            thin_film: None,
         }
+    }
+
+    /// The same lobe under a thin film (`None`: none). Energy compensation keeps the
+    /// film-less `F_ss`, as in Cycles.
+    pub fn with_thin_film(self, thin_film: Option<ThinFilm>) -> Self {
+        RoughDielectric { thin_film, ..self }
+    }
+
+    /// The film's reflectance at `c = wi·h` for relative index `eta` (`self.ior` seen from
+    /// outside, its inverse from inside, where the film's index is relative to the inside).
+    #[inline]
+    pub(crate) fn film_reflectance(&self, film: &ThinFilm, c: f32, eta: f32) -> Vec3 {
+        let film_eta = if eta == self.ior {
+            film.ior
+        } else {
+            film.ior * eta
+        };
+        let f0t = (fresnel::f0_from_ior(eta) * self.f0_tint).min(Vec3::ONE);
+        film.principled(c, eta, film_eta, f0t)
     }
 
     /// The same lobe with Cycles' Multiscatter GGX energy compensation (Glass and Reflection
@@ -304,7 +328,9 @@ impl RoughDielectric {
                 (Vec3::ZERO, t, cos_t)
             }
             DielectricMode::Glass | DielectricMode::Reflection => {
-                let fv = if self.f0_tint == Vec3::ONE {
+                let fv = if let Some(film) = &self.thin_film {
+                    self.film_reflectance(film, c, eta)
+                } else if self.f0_tint == Vec3::ONE {
                     Vec3::splat(f)
                 } else {
                     let f0 = fresnel::f0_from_ior(eta);

@@ -38,6 +38,9 @@ pub struct Principled {
     pub subsurface_anisotropy: f32,
     /// Oren–Nayar σ of the diffuse base (0: Lambert).
     pub diffuse_roughness: f32,
+    /// Thin Film Thickness (nm) and IOR, where there is a film: it colours the specular and
+    /// transmission lobes' reflectance.
+    pub thin_film: Option<crate::bsdf::thin_film::ThinFilm>,
     /// Blender's Principled (F82 metals, multiple-scattering GGX, coat and sheen layers);
     /// false for glTF materials, which keep their Schlick metal and single-scattering GGX.
     pub cycles: bool,
@@ -73,6 +76,7 @@ impl Principled {
             subsurface_scale: 0.0,
             subsurface_anisotropy: 0.0,
             diffuse_roughness: 0.0,
+            thin_film: None,
             cycles: true,
             multiscatter: true,
         }

@@ -788,6 +788,19 @@ def principled_variant(kind):
             # 4 cm against its 60 cm radius), which glows through where the sun does not reach.
             ins.update(Base_Color=(0.8, 0.6, 0.5, 1.0), Subsurface_Weight=1.0,
                        Subsurface_Radius=(1.0, 0.4, 0.2), Subsurface_Scale=0.5)
+        elif kind.startswith("thin_film"):
+            # Interference colours that change across the ball with the angle of incidence;
+            # a dark base so that the specular layer carries them.
+            ins.update(Base_Color=(0.05, 0.05, 0.08, 1.0), Roughness=0.25,
+                       Thin_Film_Thickness=500.0, Thin_Film_IOR=1.33)
+            if kind == "thin_film_smooth":
+                ins.update(Roughness=0.0, Thin_Film_Thickness=320.0, Thin_Film_IOR=1.8)
+            elif kind == "thin_film_glass":
+                ins.update(Base_Color=(1.0, 1.0, 1.0, 1.0), Transmission_Weight=1.0,
+                           Roughness=0.15, Thin_Film_Thickness=380.0)
+            elif kind == "thin_film_bubble":
+                ins.update(Base_Color=(1.0, 1.0, 1.0, 1.0), Transmission_Weight=1.0,
+                           Roughness=0.0, IOR=1.0, Thin_Film_Thickness=420.0)
         principled(nt, out, **ins)
         _sphere_stage(mat)
     return build
@@ -1181,6 +1194,10 @@ CASES = [
     # The Sheen BSDF is a sheen layer over a black base: it took the black-base bug's toll.
     ("sheen_bsdf_over_diffuse", sheen_bsdf, 0, 256, 1024),
     ("principled_subsurface", principled_variant("subsurface"), 2, 512, 2048),
+    ("principled_thin_film", principled_variant("thin_film"), 0, 256, 1024),
+    ("principled_thin_film_smooth", principled_variant("thin_film_smooth"), 0, 256, 1024),
+    ("principled_thin_film_glass", principled_variant("thin_film_glass"), 6, 256, 1024),
+    ("principled_thin_film_bubble", principled_variant("thin_film_bubble"), 6, 256, 1024),
     ("principled_subsurface_wide", principled_variant("subsurface_wide"), 2, 256, 1024),
     ("rough_glass_textured_wall", rough_glass, 4, 256, 1024),
 ]

@@ -1,5 +1,6 @@
 //! Shader nodes: BSDFs, emission, and the Mix/Add Shader nodes that weight them.
 
+use crate::bsdf::thin_film::ThinFilm;
 use crate::shading::closure::{Closure, ClosureKind, ClosureSet, Principled};
 use crate::shading::compile::{CompileError, NodeCx, SocketType};
 use crate::shading::globals::{ShaderGlobals, from_blender};
@@ -53,6 +54,8 @@ pub struct PrincipledSlots {
     subsurface_scale: Slot,
     subsurface_anisotropy: Slot,
     diffuse_roughness: Slot,
+    thin_film_thickness: Slot,
+    thin_film_ior: Slot,
     emission_color: Slot,
     emission_strength: Slot,
     cycles: bool,
@@ -294,6 +297,7 @@ impl ClosureOp {
                     subsurface_scale: s.f(p.subsurface_scale).max(0.0),
                     subsurface_anisotropy: s.f(p.subsurface_anisotropy),
                     diffuse_roughness: s.f(p.diffuse_roughness),
+                    thin_film: ThinFilm::new(s.f(p.thin_film_thickness), s.f(p.thin_film_ior)),
                     cycles: p.cycles,
                     multiscatter: p.multiscatter,
                 };
@@ -746,6 +750,8 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                 subsurface_scale: f(cx, "Subsurface Scale", 0.05)?,
                 subsurface_anisotropy: f(cx, "Subsurface Anisotropy", 0.0)?,
                 diffuse_roughness: f(cx, "Diffuse Roughness", 0.0)?,
+                thin_film_thickness: f(cx, "Thin Film Thickness", 0.0)?,
+                thin_film_ior: f(cx, "Thin Film IOR", 1.33)?,
                 emission_color: c(cx, "Emission Color", Vec3::ONE)?,
                 emission_strength: f(cx, "Emission Strength", 0.0)?,
                 cycles: !cx.prop_bool("gltf", false),
@@ -763,8 +769,10 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                 cx.emits();
             }
             let thin_film = "Thin Film Thickness";
-            if cx.is_linked(thin_film) || cx.const_value(thin_film).is_some_and(|v| v[0] != 0.0) {
-                cx.warn("thin film is not rendered");
+            if (cx.is_linked(thin_film) || cx.const_value(thin_film).is_some_and(|v| v[0] > 0.1))
+                && (cx.is_linked("Metallic") || cx.input_f32("Metallic").unwrap_or(0.0) > 0.0)
+            {
+                cx.warn("thin film on the metallic lobe is not rendered (only on the dielectric)");
             }
             let ss = "Subsurface Weight";
             if !p.cycles {
