@@ -55,13 +55,7 @@ impl Dielectric {
         let (refl, trans) = if r >= 1.0 {
             (Vec3::ONE, Vec3::ZERO)
         } else {
-            let film_eta = if cos_i > 0.0 {
-                film.ior
-            } else {
-                film.ior * eta
-            };
-            let f0t = (fresnel::f0_from_ior(eta) * k).min(Vec3::ONE);
-            let f = film.principled(cos_i.abs(), eta, film_eta, f0t);
+            let f = film.on_dielectric(cos_i.abs(), eta, cos_i < 0.0, k);
             (f, (Vec3::ONE - f) * self.tint)
         };
         let total = (refl + trans).element_sum();

@@ -114,16 +114,10 @@ impl RoughDielectric {
     }
 
     /// The film's reflectance at `c = wi·h` for relative index `eta` (`self.ior` seen from
-    /// outside, its inverse from inside, where the film's index is relative to the inside).
+    /// outside, its inverse from inside).
     #[inline]
     pub(crate) fn film_reflectance(&self, film: &ThinFilm, c: f32, eta: f32) -> Vec3 {
-        let film_eta = if eta == self.ior {
-            film.ior
-        } else {
-            film.ior * eta
-        };
-        let f0t = (fresnel::f0_from_ior(eta) * self.f0_tint).min(Vec3::ONE);
-        film.principled(c, eta, film_eta, f0t)
+        film.on_dielectric(c, eta, eta != self.ior, self.f0_tint)
     }
 
     /// The same lobe with Cycles' Multiscatter GGX energy compensation (Glass and Reflection

@@ -60,6 +60,16 @@ impl ThinFilm {
         ((s + p) * 0.5).clamp(Vec3::ZERO, Vec3::ONE)
     }
 
+    /// [`ThinFilm::principled`] for light arriving from outside or (`inside`) from within a
+    /// substrate of relative index `eta` seen from the incident side, `F0 = F0(eta)` scaled by
+    /// `f0_scale` (Specular Tint): the film's index is relative to the outside, so from within
+    /// it is taken relative to the substrate.
+    pub fn on_dielectric(&self, cos_i: f32, eta: f32, inside: bool, f0_scale: Vec3) -> Vec3 {
+        let film_eta = if inside { self.ior * eta } else { self.ior };
+        let f0_tint = (super::fresnel::f0_from_ior(eta) * f0_scale).min(Vec3::ONE);
+        self.principled(cos_i, eta, film_eta, f0_tint)
+    }
+
     /// The Principled BSDF's reflectance with the film: [`ThinFilm::reflectance`] with each
     /// channel scaled towards `f0_tint / F0` (Specular Tint's scale of `F0 = F0(eta)`,
     /// `f0_tint` = the tinted, clamped `F0`) as much as it lies below 1 relative to `F0`,
@@ -126,9 +136,8 @@ fn airy(table: &Table, r12: f32, r23: f32, opd: f32, phasor: f32) -> Vec3 {
     let mut ph = phasor;
     for m in 1..4 {
         cm *= root;
-        let (re, _im) = table.lookup(m as f32 * opd);
-        // Re(e^{imφ} S) with a real phasor: the imaginary part of S drops out.
-        r += re * (2.0 * cm * ph);
+        // Re(e^{imφ} S) with a real phasor: only the real part of S is needed.
+        r += table.lookup(m as f32 * opd) * (2.0 * cm * ph);
         ph *= phasor;
     }
     r
@@ -139,30 +148,27 @@ const TABLE_SIZE: usize = 512;
 /// Optical path difference (nm) the table's last entry stands for: `60 µm / 2π`.
 const TABLE_OPD: f32 = 60_000.0 / std::f32::consts::TAU;
 
-/// `S(OPD)` per RGB channel, real and imaginary parts.
+/// `Re S(OPD)` per RGB channel: with a dielectric substrate the phase shifts are 0 or π, so
+/// the imaginary part never enters the sum.
 struct Table {
     re: Vec<Vec3>,
-    im: Vec<Vec3>,
 }
 
 impl Table {
     /// Linear interpolation between entries, clamped at the ends.
-    fn lookup(&self, opd: f32) -> (Vec3, Vec3) {
+    fn lookup(&self, opd: f32) -> Vec3 {
         let x = (opd / TABLE_OPD).clamp(0.0, 1.0) * (TABLE_SIZE - 1) as f32;
         let i = (x as usize).min(TABLE_SIZE - 1);
         let j = (i + 1).min(TABLE_SIZE - 1);
         let t = x - i as f32;
-        (
-            self.re[i] * (1.0 - t) + self.re[j] * t,
-            self.im[i] * (1.0 - t) + self.im[j] * t,
-        )
+        self.re[i] * (1.0 - t) + self.re[j] * t
     }
 }
 
 /// The sensitivity table, built on first use: the colour matching functions resampled at
 /// `N` frequencies `ν_n = n π / 60 µm⁻¹` (with the `dλ = dν / ν²` change of measure),
-/// their discrete Fourier transform at `k = 0 .. TABLE_SIZE`, converted from XYZ to the
-/// working RGB and normalised by each channel's `k = 0` term.
+/// the real part of their discrete Fourier transform at `k = 0 .. TABLE_SIZE`, converted
+/// from XYZ to the working RGB and normalised by each channel's `k = 0` term.
 fn table() -> &'static Table {
     static TABLE: OnceLock<Table> = OnceLock::new();
     TABLE.get_or_init(|| {
@@ -184,33 +190,26 @@ fn table() -> &'static Table {
             [row(m[0]), row(m[1]), row(m[2])]
         };
         let mut re = Vec::with_capacity(TABLE_SIZE);
-        let mut im = Vec::with_capacity(TABLE_SIZE);
         let mut norm = [1.0f64; 3];
         for k in 0..TABLE_SIZE {
-            let (mut a, mut b) = ([0.0f64; 3], [0.0f64; 3]);
+            let mut a = [0.0f64; 3];
             for &(n, s) in &samples {
-                let theta = std::f64::consts::TAU * (k * n) as f64 / N as f64;
-                let (sin, cos) = theta.sin_cos();
+                let cos = (std::f64::consts::TAU * (k * n) as f64 / N as f64).cos();
                 for c in 0..3 {
                     a[c] += s[c] * cos;
-                    b[c] -= s[c] * sin;
                 }
             }
-            let (a, b) = (to_rgb(a), to_rgb(b));
+            let a = to_rgb(a);
             if k == 0 {
                 norm = [1.0 / a[0], 1.0 / a[1], 1.0 / a[2]];
             }
-            let v = |x: [f64; 3]| {
-                Vec3::new(
-                    (x[0] * norm[0]) as f32,
-                    (x[1] * norm[1]) as f32,
-                    (x[2] * norm[2]) as f32,
-                )
-            };
-            re.push(v(a));
-            im.push(v(b));
+            re.push(Vec3::new(
+                (a[0] * norm[0]) as f32,
+                (a[1] * norm[1]) as f32,
+                (a[2] * norm[2]) as f32,
+            ));
         }
-        Table { re, im }
+        Table { re }
     })
 }
 
