@@ -342,8 +342,9 @@ fn render_samples(
                 SobolSampler::new(independent_seed(opts.seed, s), pixel_index, 0)
             }
         };
-        // Dimension 0: the pixel filter; 1: the lens, only for cameras with depth of field.
-        let u = ctx.sampler.next_2d();
+        // Dimension 0: the pixel filter (with the first BSDF sample's pair reserved, see
+        // `next_2d_reserving`); 1: the lens, only for cameras with depth of field.
+        let u = ctx.sampler.next_2d_reserving();
         let film = Vec2::new(
             px as f32 + opts.filter.offset(u.x),
             py as f32 + opts.filter.offset(u.y),

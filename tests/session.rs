@@ -965,9 +965,9 @@ fn moving_an_instance_equals_loading_it_moved() {
         max_diff(&moved, &before) > 0.05,
         "the instance did not move"
     );
-    assert_eq!(
-        max_diff(&moved, &file),
-        0.0,
-        "moved instance differs from the file's"
-    );
+    // Equal up to the last bits: the moved scene's acceleration structure is built from other
+    // inputs than the file's, so a ray through an edge two triangles share may take the
+    // other one (a difference of 7e-9 seen); a misplaced instance differs by > 0.05.
+    let d = max_diff(&moved, &file);
+    assert!(d < 1e-6, "moved instance differs from the file's by {d}");
 }

@@ -621,7 +621,8 @@ impl ShadingPoint {
         d: Vec3,
     ) -> Option<(Vec3, Vec3, BsdfQueryRecord)> {
         let mut rec = BsdfQueryRecord::new(self.wi);
-        let u = ctx.sampler.next_2d();
+        // The path's first BSDF sample is stratified jointly with the pixel filter's offset.
+        let u = ctx.sampler.reserved_2d();
         let u1 = ctx.sampler.next_1d();
         if let Some(g) = &self.glossy_frame {
             let (wo, mut rec) = self.two_frame_sample(g, d, u, u1)?;
