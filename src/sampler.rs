@@ -3,9 +3,12 @@
 //! Each camera sample owns a sampler seeded from `(seed, pixel index, sample index)` only,
 //! never from a thread or a tile, so an image is bit-identical for any thread count.
 //! [`Sampler`] is a plain PCG32 stream; [`SobolSampler`], used by the renderer, draws each
-//! dimension pair from an Owen-scrambled (0,2)-sequence (Sobol's first two dimensions) whose
-//! sample order is shuffled per pixel and dimension (Burley 2020, "Practical Hash-based Owen
-//! Scrambling"), so the samples of one pixel are stratified in every 2D projection it uses.
+//! dimension slot (a number, a pair, or a pair with a number) from the first Sobol dimensions
+//! of one index, Owen-scrambled, whose sample order is shuffled per pixel and slot (Burley
+//! 2020, "Practical Hash-based Owen Scrambling"), so the samples of one pixel are stratified
+//! within every slot it uses. Lights and lobes are chosen with the number of their point's
+//! slot, as Cycles does, and the pixel filter's slot also carries the path's first BSDF
+//! sample ([`SobolSampler::next_2d_reserving`]).
 
 use glam::Vec2;
 
@@ -116,21 +119,22 @@ const fn sobol_directions(s: usize, a: u32, m: [u32; 3]) -> [u32; 32] {
     v
 }
 
-/// Sobol's dimensions 1 to 3 (dimension 0 is van der Corput's): the polynomials `x + 1`,
-/// `x² + x + 1` and `x³ + x + 1` with Joe and Kuo's initial numbers.
-const SOBOL_DIRECTIONS: [[u32; 32]; 3] = [
+/// Sobol's dimensions 1 to 4 (dimension 0 is van der Corput's): the polynomials `x + 1`,
+/// `x² + x + 1`, `x³ + x + 1` and `x³ + x² + 1` with Joe and Kuo's initial numbers.
+const SOBOL_DIRECTIONS: [[u32; 32]; 4] = [
     sobol_directions(1, 0, [1, 0, 0]),
     sobol_directions(2, 1, [1, 3, 0]),
     sobol_directions(3, 1, [1, 3, 1]),
+    sobol_directions(3, 2, [1, 1, 1]),
 ];
 
 /// `SOBOL_REV_BYTES[d][b][x]`: XOR of the bit-reversed direction numbers of dimension `d + 1`
 /// selected by byte `b` of an index equal to `x` (reversal commutes with XOR: the tables give
 /// the dimension bit-reversed, which is what the sampler scrambles).
-const fn sobol_rev_byte_tables() -> [[[u32; 256]; 4]; 3] {
-    let mut t = [[[0u32; 256]; 4]; 3];
+const fn sobol_rev_byte_tables() -> [[[u32; 256]; 4]; 4] {
+    let mut t = [[[0u32; 256]; 4]; 4];
     let mut d = 0;
-    while d < 3 {
+    while d < 4 {
         let v = SOBOL_DIRECTIONS[d];
         let mut b = 0;
         while b < 4 {
@@ -154,7 +158,7 @@ const fn sobol_rev_byte_tables() -> [[[u32; 256]; 4]; 3] {
     t
 }
 
-static SOBOL_REV_BYTES: [[[u32; 256]; 4]; 3] = sobol_rev_byte_tables();
+static SOBOL_REV_BYTES: [[[u32; 256]; 4]; 4] = sobol_rev_byte_tables();
 
 /// Sobol dimension `d + 1` at index `i`, bit-reversed; four table lookups.
 #[inline]
@@ -179,9 +183,9 @@ pub struct SobolSampler {
     /// The sample index, bit-reversed (what the index shuffle starts from).
     index_rev: u32,
     dim: u32,
-    /// Sobol dimensions 2 and 3 of the point [`Self::next_2d_reserving`] drew, until
-    /// [`Self::reserved_2d`] takes them.
-    reserved: Option<Vec2>,
+    /// Sobol dimensions 0-2 of the point [`Self::next_2d_reserving`] drew, until
+    /// [`Self::reserved_3d`] takes them.
+    reserved: Option<(Vec2, f32)>,
 }
 
 impl SobolSampler {
@@ -232,38 +236,53 @@ impl SobolSampler {
         Vec2::new(to_unit(x), to_unit(y))
     }
 
-    /// A 2D sample drawn as half of a 4D Sobol point (each coordinate scrambled on its own):
-    /// it returns Sobol's dimensions 2 and 3 and keeps dimensions 0 and 1 for
-    /// [`Self::reserved_2d`], so the two pairs are stratified jointly, not only each in its
-    /// plane (every plane of two of the four is a (t, m, 2)-net with t <= 1; the kept pair
-    /// has t = 0). The renderer draws the pixel filter's offset this way and the path's first
-    /// BSDF sample takes the kept pair: where the surface changes across a pixel (normal maps,
-    /// edges) the directions sampled stay spread over the pixel's area, which independent
-    /// pairs leave to chance (a diffuse normal-mapped floor under a uniform sky: 0.5x the
-    /// variance at 64 spp).
+    /// Sobol's dimensions `0..N` of the shuffled index of the next dimension slot, each
+    /// Owen-scrambled with its own seed (dimensions 0 and 1 with [`Self::next_2d`]'s).
     #[inline]
-    pub fn next_2d_reserving(&mut self) -> Vec2 {
+    fn point<const N: usize>(&mut self) -> [f32; N] {
+        const SCRAMBLE: [u64; 5] = [0x51, 0xa3, 0x1b7, 0x2c9, 0x3e5];
         let s = self.next_seed();
         let i = self.shuffled_rev(hash32(s)).reverse_bits();
-        let x = laine_karras(i, hash32(s ^ 0x51)).reverse_bits();
-        let y = laine_karras(sobol_rev(0, i), hash32(s ^ 0xa3)).reverse_bits();
-        let z = laine_karras(sobol_rev(1, i), hash32(s ^ 0x1b7)).reverse_bits();
-        let w = laine_karras(sobol_rev(2, i), hash32(s ^ 0x2c9)).reverse_bits();
-        self.reserved = Some(Vec2::new(to_unit(x), to_unit(y)));
-        Vec2::new(to_unit(z), to_unit(w))
+        std::array::from_fn(|d| {
+            let v = if d == 0 { i } else { sobol_rev(d - 1, i) };
+            to_unit(laine_karras(v, hash32(s ^ SCRAMBLE[d])).reverse_bits())
+        })
     }
 
-    /// The pair [`Self::next_2d_reserving`] kept, the first time it is asked for; then (or
-    /// without one) [`Self::next_2d`]. It takes one dimension either way, so the dimensions
-    /// after it are the same whichever it returned.
+    /// A uniform point in `[0, 1)³` as a pair and a number: Sobol's dimensions 0-2 of one
+    /// shuffled index, so the number is stratified jointly with the pair (a choice made with
+    /// it, of a light or a lobe, leaves each choice's pairs spread), as Cycles draws its
+    /// light and BSDF samples. One dimension slot.
     #[inline]
-    pub fn reserved_2d(&mut self) -> Vec2 {
+    pub fn next_3d(&mut self) -> (Vec2, f32) {
+        let [x, y, z] = self.point::<3>();
+        (Vec2::new(x, y), z)
+    }
+
+    /// A 2D sample drawn as part of a 5D Sobol point: it returns Sobol's dimensions 3 and 4
+    /// and keeps dimensions 0-2 for [`Self::reserved_3d`], so the two samples are stratified
+    /// jointly, not only each in its own space. The renderer draws the pixel filter's offset
+    /// this way and the path's first BSDF sample takes the rest: where the surface changes
+    /// across a pixel (normal maps, edges) the directions and lobes sampled stay spread over
+    /// the pixel's area, which independent samples leave to chance.
+    #[inline]
+    pub fn next_2d_reserving(&mut self) -> Vec2 {
+        let [x, y, z, a, b] = self.point::<5>();
+        self.reserved = Some((Vec2::new(x, y), z));
+        Vec2::new(a, b)
+    }
+
+    /// The sample [`Self::next_2d_reserving`] kept, the first time it is asked for; then (or
+    /// without one) [`Self::next_3d`]. It takes one dimension slot either way, so the
+    /// dimensions after it are the same whichever it returned.
+    #[inline]
+    pub fn reserved_3d(&mut self) -> (Vec2, f32) {
         match self.reserved.take() {
             Some(p) => {
                 self.dim += 1;
                 p
             }
-            None => self.next_2d(),
+            None => self.next_3d(),
         }
     }
 }
@@ -357,7 +376,7 @@ mod tests {
 
     #[test]
     fn sobol_tables_match_definition() {
-        for d in 0..3 {
+        for d in 0..4 {
             for i in [0u32, 1, 2, 3, 5, 255, 256, 0xdead_beef, u32::MAX] {
                 assert_eq!(
                     sobol_rev(d, i),
@@ -379,6 +398,7 @@ mod tests {
         assert_eq!(m(0), [1, 3, 5, 15]);
         assert_eq!(m(1), [1, 3, 3, 9]);
         assert_eq!(m(2), [1, 3, 1, 5]);
+        assert_eq!(m(3), [1, 1, 1, 11]);
     }
 
     /// The least `t` for which `pts` (n = 2^k points in [0,1)^2) is a (t, k, 2)-net: every
@@ -401,45 +421,57 @@ mod tests {
     }
 
     #[test]
-    fn reserved_pair_is_stratified_with_the_first_pair() {
-        // 64 samples of one pixel: the four numbers are one point of a scrambled Sobol
-        // sequence, so every plane of two of them is a (t, 6, 2)-net with t <= 1 (the kept
-        // pair, Sobol's dimensions 0 and 1: t = 0). Drawn as two independent pairs (next_2d
-        // twice), a cross plane is stratified only by chance.
-        let (mut a, mut b, mut xz, mut yw, mut ind) = (vec![], vec![], vec![], vec![], vec![]);
+    fn reserved_sample_is_stratified_with_the_pixel_sample() {
+        // 64 samples of one pixel: the five numbers are one point of a scrambled Sobol
+        // sequence, so every plane of two of them is a (t, 6, 2)-net with t <= 3 (the kept
+        // pair, Sobol's dimensions 0 and 1: t = 0; the pixel's pair t = 1). Drawn
+        // independently (next_2d, next_3d), a plane across the two is stratified only by
+        // chance (t = 5 here).
+        let mut v: Vec<[f32; 5]> = vec![];
+        let mut ind = vec![];
         for i in 0..64 {
             let mut s = SobolSampler::new(3, 41, i);
             let p = s.next_2d_reserving();
-            let q = s.reserved_2d();
-            a.push(p);
-            b.push(q);
-            xz.push(Vec2::new(p.x, q.x));
-            yw.push(Vec2::new(p.y, q.y));
+            let (q, c) = s.reserved_3d();
+            v.push([q.x, q.y, c, p.x, p.y]);
             let mut t = SobolSampler::new(3, 41, i);
             let p = t.next_2d();
-            ind.push(Vec2::new(p.x, t.next_2d().x));
+            ind.push(Vec2::new(p.x, t.next_3d().0.x));
         }
-        let t = [net_t(&a), net_t(&b), net_t(&xz), net_t(&yw), net_t(&ind)];
-        assert!(t[0] <= 1 && t[1] == 0 && t[2] <= 1 && t[3] <= 1, "{t:?}");
-        assert!(t[4] >= 3, "{t:?}");
+        let plane =
+            |a: usize, b: usize| v.iter().map(|p| Vec2::new(p[a], p[b])).collect::<Vec<_>>();
+        let mut worst = 0;
+        for a in 0..5 {
+            for b in a + 1..5 {
+                worst = worst.max(net_t(&plane(a, b)));
+            }
+        }
+        assert_eq!(net_t(&plane(0, 1)), 0);
+        assert!(net_t(&plane(3, 4)) <= 1);
+        assert!(worst <= 3, "a plane with t = {worst}");
+        assert!(net_t(&ind) >= 5, "independent samples: t = {}", net_t(&ind));
     }
 
     #[test]
-    fn reserved_pair_keeps_later_dimensions() {
-        // Whether or not the reserved pair is taken, the dimensions after it are the same;
+    fn reserved_sample_keeps_later_dimensions() {
+        // Whether or not the reserved sample is taken, the dimensions after it are the same;
         // it is handed out once.
         let mut a = SobolSampler::new(9, 5, 17);
         let mut b = SobolSampler::new(9, 5, 17);
         a.next_2d_reserving();
         b.next_2d_reserving();
-        let q = a.reserved_2d();
+        let q = a.reserved_3d();
         b.next_2d();
         assert_eq!(a.next_2d(), b.next_2d());
-        assert_ne!(a.reserved_2d(), q);
-        // The kept pair is what next_2d would have drawn in that dimension.
+        assert_ne!(a.reserved_3d(), q);
+        // The kept pair is what next_2d would have drawn in that dimension slot.
         let mut c = SobolSampler::new(2, 3, 4);
         c.next_2d_reserving();
-        assert_eq!(c.reserved_2d(), SobolSampler::new(2, 3, 4).next_2d());
+        assert_eq!(c.reserved_3d().0, SobolSampler::new(2, 3, 4).next_2d());
+        assert_eq!(
+            SobolSampler::new(7, 1, 2).next_3d().0,
+            SobolSampler::new(7, 1, 2).next_2d()
+        );
     }
 
     #[test]

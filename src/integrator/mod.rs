@@ -621,9 +621,9 @@ impl ShadingPoint {
         d: Vec3,
     ) -> Option<(Vec3, Vec3, BsdfQueryRecord)> {
         let mut rec = BsdfQueryRecord::new(self.wi);
-        // The path's first BSDF sample is stratified jointly with the pixel filter's offset.
-        let u = ctx.sampler.reserved_2d();
-        let u1 = ctx.sampler.next_1d();
+        // The direction's pair and the lobe's number drawn jointly; the path's first BSDF
+        // sample jointly with the pixel filter's offset too.
+        let (u, u1) = ctx.sampler.reserved_3d();
         if let Some(g) = &self.glossy_frame {
             let (wo, mut rec) = self.two_frame_sample(g, d, u, u1)?;
             let (f, pdf) = self.two_frame_eval_cos_pdf(g, d, wo, false);
@@ -776,8 +776,8 @@ pub fn sample_emitter_towards(
     mis: bool,
 ) -> (Vec3, Vec3) {
     let none = (Vec3::ZERO, Vec3::ZERO);
-    let uc = ctx.sampler.next_1d();
-    let u = ctx.sampler.next_2d();
+    // The light's choice and its point drawn jointly.
+    let (u, uc) = ctx.sampler.next_3d();
     let (light, rec, weight) = scene.sample_light(its.p, (uc, u), ctx.light_sample_at(), mis);
     if weight == Vec3::ZERO || !scene.light_reaches(light, sp.light_class()) {
         return none;

@@ -105,8 +105,7 @@ fn through_medium<S: Sink>(
 /// sampling by the power heuristic.
 #[inline]
 fn sample_emitter_in_medium(scene: &RenderScene, ctx: &mut Ctx, p: Vec3, d: Vec3) -> Vec3 {
-    let uc = ctx.sampler.next_1d();
-    let u = ctx.sampler.next_2d();
+    let (u, uc) = ctx.sampler.next_3d();
     let (light, rec, weight) = scene.sample_light(p, (uc, u), ctx.light_sample_at(), true);
     if weight == Vec3::ZERO {
         return Vec3::ZERO;
