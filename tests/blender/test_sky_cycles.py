@@ -54,8 +54,8 @@ def preetham_scene():
 
 # (id, builder, Cycles max bounces, spp, film_transparent)
 CASES = [
-    ("multiple_scattering", lambda: lit_scene("MULTIPLE_SCATTERING", 30.0), 3, 64, False),
-    ("single_scattering", lambda: lit_scene("SINGLE_SCATTERING", 25.0), 3, 64, False),
+    ("multiple_scattering", lambda: lit_scene("MULTIPLE_SCATTERING", 30.0), 3, 128, False),
+    ("single_scattering", lambda: lit_scene("SINGLE_SCATTERING", 25.0), 3, 128, False),
     ("horizon", horizon_scene, 1, 16, False),
     ("preetham", preetham_scene, 3, 64, False),
 ]
