@@ -342,7 +342,7 @@ fn render_samples(
                 SobolSampler::new(independent_seed(opts.seed, s), pixel_index, 0)
             }
         };
-        // Dimension 0: the pixel filter (with the first BSDF sample's pair reserved, see
+        // Dimension 0: the pixel filter (with the first BSDF sample reserved, see
         // `next_2d_reserving`); 1: the lens, only for cameras with depth of field.
         let u = ctx.sampler.next_2d_reserving();
         let film = Vec2::new(

@@ -214,30 +214,11 @@ impl SobolSampler {
         laine_karras(self.index_rev, h)
     }
 
-    /// A uniform number in `[0, 1)`: the van der Corput point of the shuffled index `i`,
-    /// Owen-scrambled — `nested_uniform_scramble(i.reverse_bits(), h)`, written with the
-    /// reversals that cancel taken out (`reverse_bits` is a dozen instructions on x86-64).
-    #[inline]
-    pub fn next_1d(&mut self) -> f32 {
-        let s = self.next_seed();
-        let i = self.shuffled_rev(hash32(s)).reverse_bits();
-        to_unit(laine_karras(i, hash32(s ^ 0x51)).reverse_bits())
-    }
-
-    /// A uniform point in `[0, 1)²`: the first two Sobol dimensions of the shuffled index `i`,
-    /// each Owen-scrambled (`nested_uniform_scramble(i.reverse_bits(), h1)` and
-    /// `nested_uniform_scramble(sobol1(i), h2)`, with the reversals that cancel taken out).
-    #[inline]
-    pub fn next_2d(&mut self) -> Vec2 {
-        let s = self.next_seed();
-        let i = self.shuffled_rev(hash32(s)).reverse_bits();
-        let x = laine_karras(i, hash32(s ^ 0x51)).reverse_bits();
-        let y = laine_karras(sobol_rev(0, i), hash32(s ^ 0xa3)).reverse_bits();
-        Vec2::new(to_unit(x), to_unit(y))
-    }
-
-    /// Sobol's dimensions `0..N` of the shuffled index of the next dimension slot, each
-    /// Owen-scrambled with its own seed (dimensions 0 and 1 with [`Self::next_2d`]'s).
+    /// Sobol's dimensions `0..N` of the shuffled index `i` of the next dimension slot, each
+    /// Owen-scrambled with its own seed: dimension 0 (van der Corput's) is
+    /// `nested_uniform_scramble(i.reverse_bits(), h0)` and dimension `d` is
+    /// `nested_uniform_scramble(sobol_d(i), hd)`, written with the reversals that cancel taken
+    /// out (`reverse_bits` is a dozen instructions on x86-64).
     #[inline]
     fn point<const N: usize>(&mut self) -> [f32; N] {
         const SCRAMBLE: [u64; 5] = [0x51, 0xa3, 0x1b7, 0x2c9, 0x3e5];
@@ -247,6 +228,20 @@ impl SobolSampler {
             let v = if d == 0 { i } else { sobol_rev(d - 1, i) };
             to_unit(laine_karras(v, hash32(s ^ SCRAMBLE[d])).reverse_bits())
         })
+    }
+
+    /// A uniform number in `[0, 1)`: Sobol's dimension 0 of the slot's shuffled index.
+    #[inline]
+    pub fn next_1d(&mut self) -> f32 {
+        self.point::<1>()[0]
+    }
+
+    /// A uniform point in `[0, 1)²`: Sobol's dimensions 0 and 1 of the slot's shuffled index,
+    /// a (0,2)-sequence.
+    #[inline]
+    pub fn next_2d(&mut self) -> Vec2 {
+        let [x, y] = self.point::<2>();
+        Vec2::new(x, y)
     }
 
     /// A uniform point in `[0, 1)³` as a pair and a number: Sobol's dimensions 0-2 of one
@@ -336,7 +331,7 @@ mod tests {
                 let s = seed ^ dim.wrapping_mul(0xd1b5_4a32_d192_ed03);
                 let i = nested_uniform_scramble(sample as u32, hash32(s));
                 let x = nested_uniform_scramble(i.reverse_bits(), hash32(s ^ 0x51));
-                let y = nested_uniform_scramble(sobol1(i), hash32(s ^ 0xa3));
+                let y = nested_uniform_scramble(sobol_dim(0, i), hash32(s ^ 0xa3));
                 (x, y, x)
             })
             .collect()
@@ -370,10 +365,6 @@ mod tests {
             .fold(0, |r, k| r ^ v[k])
     }
 
-    fn sobol1(i: u32) -> u32 {
-        sobol_dim(0, i)
-    }
-
     #[test]
     fn sobol_tables_match_definition() {
         for d in 0..4 {
@@ -386,8 +377,8 @@ mod tests {
             }
         }
         // Dimension 1: v[k] = v[k-1] ^ (v[k-1] >> 1).
-        assert_eq!(sobol1(1), 1 << 31);
-        assert_eq!(sobol1(2), 3 << 30);
+        assert_eq!(sobol_dim(0, 1), 1 << 31);
+        assert_eq!(sobol_dim(0, 2), 3 << 30);
         // The first m_k of each dimension: Joe and Kuo's initial numbers, continued by
         // m_k = 2 a_1 m_(k-1) ^ ... ^ 2^s m_(k-s) ^ m_(k-s) (worked by hand).
         let m = |d: usize| {
