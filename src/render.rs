@@ -366,7 +366,7 @@ fn render_samples(
         } else {
             integrator.li(scene, ctx, ray.o, ray.d)
         };
-        if l.is_finite() && l.min_element() >= 0.0 {
+        if l.is_finite() {
             acc.sum += l;
             acc.accepted += 1;
             if transparent {

@@ -123,7 +123,7 @@ fn assert_irradiance(name: &str, scene: &dyn Fn() -> Scene, expected_e: f64, spp
     let want = expected_e * RHO as f64 / PI64;
     for integrator in ALL {
         let (mean, se) = render_mean(scene(), integrator, spp, 2);
-        let tol = 4.0 * se + 2e-3 * want;
+        let tol = 4.0 * se + 2e-3 * want.abs();
         println!("{name} {integrator}: {mean:.6} vs {want:.6} (se {se:.2e})");
         assert!(
             (mean - want).abs() <= tol,
@@ -158,6 +158,34 @@ fn sphere_and_disk_lights_light_a_plane_exactly() {
         let name = if soft { "disk light" } else { "sphere light" };
         assert_irradiance(name, &scene, e, 256);
     }
+}
+
+#[test]
+fn negative_lights_take_their_irradiance_away() {
+    // A light of negative power (Cycles renders them: artists darken corners so) adds its
+    // negative irradiance: a 60 W sphere light and a -10 W area light above the point give
+    // E(60 W) - E(10 W), for every integrator (the light choice weighs the area light by
+    // the magnitude of its power, so it is still sampled).
+    let (c, power, r) = (v(0.5, 1.0, -0.3), 60.0f32, 0.4f32);
+    let (cos, d) = geometry(c);
+    let sphere = power as f64 / (4.0 * PI64) * cos / (d * d);
+    let (ca, su, sv, neg) = (v(-0.2, 1.2, 0.1), 0.6f32, 0.4f32, -10.0f32);
+    let l0 = neg as f64 / (PI64 * (su * sv) as f64);
+    let area = area_irradiance(ca, su, sv, false, l0, PI64);
+    assert!(area < -0.2 * sphere, "{area} {sphere}");
+    let scene = || {
+        let mut s = floor_scene(0.05);
+        s.lights.push(blender(point(c, power, r, false)));
+        s.lights
+            .push(blender(area_down(ca, su, sv, false, neg, PI)));
+        s
+    };
+    assert_irradiance(
+        "sphere light and negative area light",
+        &scene,
+        sphere + area,
+        256,
+    );
 }
 
 #[test]

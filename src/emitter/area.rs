@@ -11,7 +11,7 @@
 //! ([`super::spherical_triangle`]).
 
 use super::spherical_triangle::{SphericalTriangle, barycentrics_along};
-use super::{Emitter, EmitterQueryRecord, luminance};
+use super::{Emitter, EmitterQueryRecord, emitted_luminance};
 use crate::sampling::{DiscreteCdf, square_to_uniform_triangle};
 use crate::scene::{Mesh, Scene};
 use crate::shading::Program;
@@ -373,7 +373,7 @@ impl Emitter for AreaEmitter {
 
     fn power(&self, _scene: &Scene, _r: f32) -> f32 {
         let sides = if self.two_sided { 2.0 } else { 1.0 };
-        luminance(self.radiance) * PI * self.area * sides
+        emitted_luminance(self.radiance) * PI * self.area * sides
     }
 
     fn is_delta(&self) -> bool {

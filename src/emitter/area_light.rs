@@ -15,7 +15,7 @@
 //! ellipse are rejected). Tiny or grazing rectangles fall back to uniform area sampling, whose
 //! density is exact at any size.
 
-use super::{Emitter, EmitterQueryRecord, luminance};
+use super::{Emitter, EmitterQueryRecord, emitted_luminance};
 use crate::sampling::square_to_uniform_disk;
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
@@ -395,7 +395,7 @@ impl Emitter for AreaLight {
     }
 
     fn power(&self, _scene: &Scene, _r: f32) -> f32 {
-        luminance(self.radiance) * PI * self.area
+        emitted_luminance(self.radiance) * PI * self.area
     }
 
     fn is_delta(&self) -> bool {

@@ -2,7 +2,7 @@
 //! diameter is a delta light; a positive one is a uniform cone of directions of half-angle
 //! `angle/2` with radiance `E / Ω_cos`, Ω_cos = π sin²(angle/2), the cone's projected solid angle.
 
-use super::{Emitter, EmitterQueryRecord, luminance};
+use super::{Emitter, EmitterQueryRecord, emitted_luminance};
 use crate::frame::Frame;
 use crate::sampling::{square_to_uniform_cone, square_to_uniform_cone_pdf};
 use crate::scene::Scene;
@@ -69,7 +69,7 @@ impl Emitter for Directional {
     }
 
     fn power(&self, _scene: &Scene, r: f32) -> f32 {
-        luminance(self.irradiance) * PI * r * r
+        emitted_luminance(self.irradiance) * PI * r * r
     }
 
     fn is_delta(&self) -> bool {

@@ -424,7 +424,11 @@ impl Environment {
             return w.emission(to_blender(d), &scene.images);
         }
         let g = background_globals(d, depth, flags);
-        self.program.emission(&g, &self.shade_env(scene))
+        // The world gives light only: its importance map and sun need radiance >= 0 (a
+        // negative Background strength is black, as before emission could be negative).
+        self.program
+            .emission(&g, &self.shade_env(scene))
+            .max(Vec3::ZERO)
     }
 
     /// The radiance light sampling sees (no Light Path bits, as Cycles' light evaluation).
@@ -819,9 +823,11 @@ mod tests {
             for k in 0..4000 {
                 let u = Vec2::new((k % 80) as f32 / 79.0, (k / 80) as f32 / 49.0);
                 let d = crate::sampling::square_to_uniform_sphere(u);
+                // Clamped as the world clamps its program's emission.
                 let by_program = env
                     .program
-                    .emission(&background_globals(d, 2, 0), &env.shade_env(&scene));
+                    .emission(&background_globals(d, 2, 0), &env.shade_env(&scene))
+                    .max(Vec3::ZERO);
                 let direct = env.radiance(&scene, d, 2, 0);
                 assert_eq!(
                     direct.to_array().map(f32::to_bits),

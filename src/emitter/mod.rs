@@ -191,6 +191,13 @@ pub fn luminance(c: Vec3) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
+/// The luminance of what an emitter gives off, whatever its sign: a light of negative strength
+/// (it removes light, as in Cycles) is chosen by the magnitude of its effect.
+#[inline]
+pub fn emitted_luminance(c: Vec3) -> f32 {
+    luminance(c.abs())
+}
+
 /// How the integrators choose one light for a shadow ray.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum LightChoice {

@@ -1,6 +1,6 @@
 //! Isotropic point light: radiant intensity `I` (W/sr); incident radiance integral `I / d²`.
 
-use super::{Emitter, EmitterQueryRecord, luminance};
+use super::{Emitter, EmitterQueryRecord, emitted_luminance};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -36,7 +36,7 @@ impl Emitter for PointLight {
     }
 
     fn power(&self, _scene: &Scene, _r: f32) -> f32 {
-        4.0 * PI * luminance(self.intensity)
+        4.0 * PI * emitted_luminance(self.intensity)
     }
 
     fn is_delta(&self) -> bool {

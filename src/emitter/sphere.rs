@@ -14,7 +14,7 @@
 //! A spot's falloff is evaluated on the direction the light travels from the sampled point.
 
 use super::spot::{spot_cos_outer, spot_falloff};
-use super::{Emitter, EmitterQueryRecord, luminance};
+use super::{Emitter, EmitterQueryRecord, emitted_luminance};
 use crate::frame::Frame;
 use crate::sampling::{square_to_uniform_disk, square_to_uniform_sphere};
 use crate::scene::{Scene, SpotFalloff};
@@ -261,7 +261,7 @@ impl Emitter for SphereLight {
     }
 
     fn power(&self, _scene: &Scene, _r: f32) -> f32 {
-        let intensity = luminance(self.radiance) * PI * self.radius * self.radius;
+        let intensity = emitted_luminance(self.radiance) * PI * self.radius * self.radius;
         match &self.spot {
             Some((_, f)) => 2.0 * PI * (1.0 - spot_cos_outer(f)).max(0.0) * intensity,
             None => 4.0 * PI * intensity,

@@ -1,7 +1,7 @@
 //! Spot light: a point light whose intensity `I` (W/sr) is scaled by an angular falloff around
 //! its axis (glTF's quadratic ramp, or Cycles' smoothstep of the blend region).
 
-use super::{Emitter, EmitterQueryRecord, luminance};
+use super::{Emitter, EmitterQueryRecord, emitted_luminance};
 use crate::scene::{Scene, SpotFalloff};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -97,7 +97,7 @@ impl Emitter for SpotLight {
     }
 
     fn power(&self, _scene: &Scene, _r: f32) -> f32 {
-        2.0 * PI * (1.0 - self.cos_outer()).max(0.0) * luminance(self.intensity)
+        2.0 * PI * (1.0 - self.cos_outer()).max(0.0) * emitted_luminance(self.intensity)
     }
 
     fn is_delta(&self) -> bool {

@@ -267,9 +267,11 @@ impl ClosureSet {
         });
     }
 
+    /// Adds emitted radiance; a negative one takes light away, as Cycles' emission closures
+    /// with a negative colour or strength do.
     pub fn add_emission(&mut self, e: Vec3) {
         if e.is_finite() {
-            self.emission += e.max(Vec3::ZERO);
+            self.emission += e;
         }
     }
 

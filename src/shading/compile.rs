@@ -128,7 +128,7 @@ pub fn compile(graph: &Graph, material: &str) -> std::result::Result<Compiled, C
     if !c.varying {
         // Closure operations read only constant slots: run once now.
         let set = program.run_at_origin();
-        program.may_emit = set.emission.max_element() > 0.0;
+        program.may_emit = set.emission != Vec3::ZERO;
         program.may_pass = set.holdout != Vec3::ZERO
             || set
                 .closures()

@@ -227,6 +227,37 @@ def sunlit_room():
     return scenes.SceneInfo(scene, "sunlit_room")
 
 
+def negative_lights():
+    """Lights of negative strength take light away (Cycles renders them so): a point light of
+    -60 W with a radius darkens the box's left side, a -40 W area light a patch of the floor,
+    both against a 400 W point light; the negative sphere is seen by the camera. A renderer
+    that skips or clamps them is 10-30% too bright."""
+    info = _plane_with_box()
+    scenes.add_point_light("Key", (0.8, -0.5, 1.6), 400.0, radius=0.1)
+    scenes.add_point_light("Darken", (-0.7, -0.3, 0.9), -60.0, radius=0.1)
+    scenes.add_area_light("DarkPatch", (0.9, 0.9, 1.2), (0.9, 0.9, 0.0), -40.0, 0.5)
+    return info
+
+
+def negative_emission():
+    """An Emission shader of strength -3 on a sphere beside the box (Blender clamps colours at
+    0, not strengths): a surface that takes light away from what it would light, as in Cycles,
+    and shows negative radiance itself. (Cycles ignores a Principled BSDF's negative emission
+    strength, and so does Tesela.)"""
+    info = _plane_with_box()
+    scenes.add_point_light("Key", (0.8, -0.5, 1.6), 400.0, radius=0.1)
+    sink = bpy.data.materials.new("Sink")
+    sink.use_nodes = True
+    nt = sink.node_tree
+    nt.nodes.remove(nt.nodes["Principled BSDF"])
+    e = nt.nodes.new("ShaderNodeEmission")
+    e.inputs["Color"].default_value = (1.0, 0.8, 0.6, 1.0)
+    e.inputs["Strength"].default_value = -3.0
+    nt.links.new(e.outputs["Emission"], nt.nodes["Material Output"].inputs["Surface"])
+    scenes.add_sphere("Sink", (-0.8, 0.3, 0.4), 0.3, sink)
+    return info
+
+
 # (id, builder, Cycles max_bounces, Tesela integrator, spp)
 CASES = [
     ("point_radius_soft", point_radius(True), 0, "direct_mis", 512),
@@ -244,6 +275,8 @@ CASES = [
     ("area_square_spread0", area_spread("SQUARE", 0.0), 0, "direct_mis", 64),
     ("visibility_flags", visibility_flags, 1, "path_mis", 1024),
     ("sunlit_room", sunlit_room, 2, "path_mis", 1024),
+    ("negative_lights", negative_lights, 2, "path_mis", 1024),
+    ("negative_emission", negative_emission, 2, "path_mis", 256),
 ]
 
 

@@ -16,6 +16,12 @@ fn valid_color(c: Vec3) -> bool {
     c.is_finite() && c.min_element() >= 0.0
 }
 
+/// A Blender light's emission: any finite colour. A negative strength is a light that takes
+/// light away, as Cycles renders it (an artist's trick to darken a corner).
+fn valid_emission(c: Vec3) -> bool {
+    c.is_finite()
+}
+
 impl<'a> Loader<'a> {
     /// Whether the file was written by Blender's own glTF exporter.
     fn written_by_blender_exporter(&self) -> bool {
@@ -55,7 +61,7 @@ impl<'a> Loader<'a> {
             compiled.program.constant_set().map(|set| set.emission)
         });
         match (emitted, rgb(t, "base_color")) {
-            (Some(e), Some(base)) if valid_color(e) => base * e,
+            (Some(e), Some(base)) if valid_emission(e) => base * e,
             _ => {
                 let notes = member(t, "node_warnings").and_then(Value::as_array);
                 for m in notes.into_iter().flatten().filter_map(Value::as_str) {
@@ -181,7 +187,7 @@ impl<'a> Loader<'a> {
         let shape = match ty {
             "POINT" | "SPOT" => {
                 let intensity = color * power / (4.0 * PI);
-                if !valid_color(intensity) {
+                if !valid_emission(intensity) {
                     return skip(self, "invalid color or power");
                 }
                 let mut radius = f("radius", 0.0);
@@ -223,7 +229,7 @@ impl<'a> Loader<'a> {
                 let Some(direction) = direction else {
                     return skip(self, "degenerate direction");
                 };
-                if !valid_color(irradiance) {
+                if !valid_emission(irradiance) {
                     return skip(self, "invalid color or strength");
                 }
                 if !(angle.is_finite() && (0.0..=PI).contains(&angle)) {
@@ -287,7 +293,7 @@ impl<'a> Loader<'a> {
                 let (size_u, size_v) = (size * lu, size_y * lv);
                 let area = size_u * size_v * if ellipse { PI / 4.0 } else { 1.0 };
                 let radiance = color * power / (PI * area);
-                if !(area > 0.0 && area.is_finite() && valid_color(radiance)) {
+                if !(area > 0.0 && area.is_finite() && valid_emission(radiance)) {
                     return skip(self, "zero area, or invalid color or power");
                 }
                 LightShape::Area {
