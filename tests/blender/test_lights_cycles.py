@@ -242,8 +242,9 @@ def negative_lights():
 def negative_emission():
     """An Emission shader of strength -3 on a sphere beside the box (Blender clamps colours at
     0, not strengths): a surface that takes light away from what it would light, as in Cycles,
-    and shows negative radiance itself. (Cycles ignores a Principled BSDF's negative emission
-    strength, and so does Tesela.)"""
+    and shows negative radiance itself. A Principled BSDF's negative Emission Strength typed
+    in emits nothing in Cycles (its emission is on only above a small positive strength): the
+    black ball beside the box stays black."""
     info = _plane_with_box()
     scenes.add_point_light("Key", (0.8, -0.5, 1.6), 400.0, radius=0.1)
     sink = bpy.data.materials.new("Sink")
@@ -255,6 +256,7 @@ def negative_emission():
     e.inputs["Strength"].default_value = -3.0
     nt.links.new(e.outputs["Emission"], nt.nodes["Material Output"].inputs["Surface"])
     scenes.add_sphere("Sink", (-0.8, 0.3, 0.4), 0.3, sink)
+    scenes.add_sphere("Off", (0.75, 0.55, 0.3), 0.25, scenes.emitter("Off", (1.0, 1.0, 1.0), -3.0))
     return info
 
 

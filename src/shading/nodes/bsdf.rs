@@ -724,7 +724,7 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
             }
             let f = |cx: &mut NodeCx, id: &str, d: f32| cx.float(id, d);
             let c = |cx: &mut NodeCx, id: &str, d: Vec3| cx.color(id, d);
-            let p = PrincipledSlots {
+            let mut p = PrincipledSlots {
                 base: c(cx, "Base Color", Vec3::splat(0.8))?,
                 metallic: f(cx, "Metallic", 0.0)?,
                 roughness: f(cx, "Roughness", 0.5)?,
@@ -761,12 +761,19 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
             if cx.is_linked("Alpha") || cx.const_value("Alpha").is_some_and(|v| v[0] < 1.0) {
                 cx.passes();
             }
-            if cx.is_linked("Emission Strength")
-                || cx
-                    .const_value("Emission Strength")
-                    .is_some_and(|v| v[0] != 0.0)
-            {
+            // Cycles' has_surface_emission: an unlinked colour or strength at most its closure
+            // weight cutoff switches the emission off (a negative strength typed in emits
+            // nothing; one computed by a link takes light away).
+            let on = |cx: &NodeCx, id: &str, default: f32| {
+                cx.is_linked(id)
+                    || cx.const_value(id).map_or(default, |v| {
+                        v.iter().take(3).fold(f32::NEG_INFINITY, |m, &x| m.max(x))
+                    }) > 1e-5
+            };
+            if on(cx, "Emission Color", 1.0) && on(cx, "Emission Strength", 0.0) {
                 cx.emits();
+            } else {
+                p.emission_strength = cx.constant(&[0.0])?;
             }
             let thin_film = "Thin Film Thickness";
             if (cx.is_linked(thin_film) || cx.const_value(thin_film).is_some_and(|v| v[0] > 0.1))
