@@ -425,7 +425,7 @@ impl Environment {
         }
         let g = background_globals(d, depth, flags);
         // The world gives light only: its importance map and sun need radiance >= 0 (a
-        // negative Background strength is black, as before emission could be negative).
+        // negative Background strength is black; the constant world is clamped alike).
         self.program
             .emission(&g, &self.shade_env(scene))
             .max(Vec3::ZERO)
@@ -551,9 +551,12 @@ pub fn world_emitter(
     camera_to_world: Mat4,
     warnings: &mut Vec<String>,
 ) -> Option<super::EmitterInstance> {
+    // Clamped at 0 as the world's varying radiance is (see `Environment::radiance`).
     let constant = |c: Vec3| {
         (c.max_element() > 0.0 && c.is_finite()).then_some(super::EmitterInstance::Background(
-            super::Background { radiance: c },
+            super::Background {
+                radiance: c.max(Vec3::ZERO),
+            },
         ))
     };
     let world = &scene.world;

@@ -127,6 +127,17 @@ def material(name, base_color=(0.8, 0.8, 0.8), metallic=0.0, roughness=0.5, spec
     return mat
 
 
+def shader_only(name, kind):
+    """A new material whose surface is one node of type ``kind`` (Blender's default Principled
+    BSDF removed): returns the material, its node tree and the node."""
+    m = bpy.data.materials.new(name)
+    nt = _use_nodes(m)
+    nt.nodes.remove(nt.nodes["Principled BSDF"])
+    node = nt.nodes.new(kind)
+    nt.links.new(node.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+    return m, nt, node
+
+
 def lambert(name, color):
     """A Lambertian reflector: Principled with no specular layer, roughness 1."""
     return material(name, base_color=color, roughness=1.0, specular=0.0)

@@ -32,16 +32,6 @@ def _principled(name):
     return m, m.node_tree, m.node_tree.nodes["Principled BSDF"]
 
 
-def _shader_only(name, kind):
-    m = bpy.data.materials.new(name)
-    m.use_nodes = True
-    nt = m.node_tree
-    nt.nodes.remove(nt.nodes["Principled BSDF"])
-    node = nt.nodes.new(kind)
-    nt.links.new(node.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
-    return m, nt, node
-
-
 def _world(color, strength):
     bg = bpy.context.scene.world.node_tree.nodes["Background"]
     bg.inputs["Color"].default_value = (*color, 1.0)
@@ -80,7 +70,7 @@ def procedural_studio():
     mk.data.materials.append(m)
     bpy.ops.mesh.primitive_plane_add(size=8)
     floor = bpy.context.active_object
-    m2, nt2, mix = _shader_only("Floor", "ShaderNodeMixShader")
+    m2, nt2, mix = scenes.shader_only("Floor", "ShaderNodeMixShader")
     chk = nt2.nodes.new("ShaderNodeTexChecker")
     chk.inputs["Scale"].default_value = 8.0
     chk.inputs["Color1"].default_value = (0.8, 0.8, 0.8, 1)
@@ -97,7 +87,7 @@ def procedural_studio():
     bpy.ops.mesh.primitive_uv_sphere_add(radius=0.35, location=(1.1, -0.4, 0.35))
     ball = bpy.context.active_object
     bpy.ops.object.shade_smooth()
-    m3, _, glass = _shader_only("Glass", "ShaderNodeBsdfGlass")
+    m3, _, glass = scenes.shader_only("Glass", "ShaderNodeBsdfGlass")
     glass.inputs["Roughness"].default_value = 0.1
     ball.data.materials.append(m3)
     disk = scenes.add_area_light("Disk", (-1.5, -1.0, 2.5), (0, 0, 0.5), 300.0, 1.0)
@@ -270,7 +260,7 @@ def world_tricks():
     bpy.ops.mesh.primitive_plane_add(size=1, location=(-1.2, 0.8, 0.6))
     strip = bpy.context.active_object
     strip.scale, strip.rotation_euler = (0.15, 1, 1), (0, math.radians(90), 0.3)
-    m3, n3, em = _shader_only("Strip", "ShaderNodeEmission")
+    m3, n3, em = scenes.shader_only("Strip", "ShaderNodeEmission")
     bb3 = n3.nodes.new("ShaderNodeBlackbody")
     bb3.inputs["Temperature"].default_value = 8000
     em.inputs["Strength"].default_value = 6

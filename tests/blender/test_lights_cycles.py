@@ -247,14 +247,9 @@ def negative_emission():
     black ball beside the box stays black."""
     info = _plane_with_box()
     scenes.add_point_light("Key", (0.8, -0.5, 1.6), 400.0, radius=0.1)
-    sink = bpy.data.materials.new("Sink")
-    sink.use_nodes = True
-    nt = sink.node_tree
-    nt.nodes.remove(nt.nodes["Principled BSDF"])
-    e = nt.nodes.new("ShaderNodeEmission")
+    sink, _, e = scenes.shader_only("Sink", "ShaderNodeEmission")
     e.inputs["Color"].default_value = (1.0, 0.8, 0.6, 1.0)
     e.inputs["Strength"].default_value = -3.0
-    nt.links.new(e.outputs["Emission"], nt.nodes["Material Output"].inputs["Surface"])
     scenes.add_sphere("Sink", (-0.8, 0.3, 0.4), 0.3, sink)
     scenes.add_sphere("Off", (0.75, 0.55, 0.3), 0.25, scenes.emitter("Off", (1.0, 1.0, 1.0), -3.0))
     return info
