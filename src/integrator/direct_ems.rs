@@ -35,6 +35,7 @@ impl SplitsLight for DirectEms {
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
         let mut transparent = 0;
+        let mut sp = ShadingPoint::unshaded();
         loop {
             let last = depth >= self.max_depth;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
@@ -52,9 +53,9 @@ impl SplitsLight for DirectEms {
             if depth >= self.max_depth {
                 return l;
             }
-            let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
+            if !sp.shade(scene, ctx, &its, d, depth) {
                 return l;
-            };
+            }
             if sp.passes {
                 // Straight through a transparent closure: not a bounce (Cycles counts these
                 // separately, up to its default of 8).

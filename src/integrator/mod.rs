@@ -141,18 +141,37 @@ pub struct ShadingPoint {
 }
 
 impl ShadingPoint {
+    /// A shading point to [`Self::shade`] into: one per path, reused at every vertex, so
+    /// that the BSDF (hundreds of bytes for layered ones) is written in place rather than
+    /// built aside and copied at each vertex.
+    pub fn unshaded() -> Self {
+        let frame = Frame::from_normal(Vec3::Z);
+        ShadingPoint {
+            passes: false,
+            bsdf: BsdfInstance::Diffuse(bsdf::Diffuse::new(Vec3::ZERO)),
+            frame,
+            wi: Vec3::Z,
+            weight: Vec3::ZERO,
+            subsurface: None,
+            smooth: None,
+            glossy_frame: None,
+        }
+    }
+
     /// Evaluates the material at the hit (path vertex `depth`), chooses one closure and its
-    /// BSDF (one random number for both) and sets up the frame. Opaque surfaces shade both
-    /// faces (the frame is flipped towards the viewer); transmissive ones keep the normal's
-    /// outward side to tell entering from leaving. Microfacet lobes have their alphas raised
-    /// to at least `ctx.blur` (Filter Glossy). `None` when nothing scatters there.
-    pub fn new(
+    /// BSDF (one random number for both) and sets up the frame, in place of what `self`
+    /// held. Opaque surfaces shade both faces (the frame is flipped towards the viewer);
+    /// transmissive ones keep the normal's outward side to tell entering from leaving.
+    /// Microfacet lobes have their alphas raised to at least `ctx.blur` (Filter Glossy).
+    /// False (and `self` left unusable) when nothing scatters there.
+    pub fn shade(
+        &mut self,
         scene: &RenderScene,
         ctx: &mut Ctx,
         its: &Intersection,
         d: Vec3,
         depth: u32,
-    ) -> Option<Self> {
+    ) -> bool {
         let u = ctx.sampler.next_1d();
         let caustics_off =
             if depth > 1 && ctx.ray_flags & crate::shading::globals::ray::DIFFUSE != 0 {
@@ -162,26 +181,36 @@ impl ShadingPoint {
             };
         let blur = ctx.blur;
         let walks = ctx.walks_subsurface;
-        let (closure, inv_p, u) = scene.choose_closure(ctx, its, d, depth, u)?;
+        let Some((closure, inv_p, u)) = scene.choose_closure(ctx, its, d, depth, u) else {
+            return false;
+        };
         let rest;
         let (closure, u, share) = match subsurface::split(closure, walks) {
             None => (closure, u, 1.0),
             Some(s) => match crate::sampling::pick(s.p, u) {
-                (true, _) => return Some(Self::subsurface_entry(its, d, closure, inv_p, &s)),
+                (true, _) => {
+                    *self = Self::subsurface_entry(its, d, closure, inv_p, &s);
+                    return true;
+                }
                 (false, u) => {
                     rest = s.rest;
                     (&rest, u, 1.0 / (1.0 - s.p))
                 }
             },
         };
-        let bsdf = if caustics_off == 0 && blur == 0.0 {
-            bsdf::from_closure(closure, u)
+        // Written in place (see `unshaded`).
+        if caustics_off == 0 && blur == 0.0 {
+            self.bsdf = bsdf::from_closure(closure, u);
         } else if caustics_off == 0 {
-            bsdf::closure::from_closure_blurred(closure, u, blur)
+            self.bsdf = bsdf::closure::from_closure_blurred(closure, u, blur);
         } else {
             // Cycles leaves the closures of the caustics switched off out.
-            bsdf::closure::from_closure_without_caustics(closure, u, caustics_off, blur)?
-        };
+            match bsdf::closure::from_closure_without_caustics(closure, u, caustics_off, blur) {
+                Some(b) => self.bsdf = b,
+                None => return false,
+            }
+        }
+        let bsdf = &self.bsdf;
         // The closure's normal faces the viewer (Cycles' N); zero means the shading normal.
         let mut n = if closure.normal == Vec3::ZERO {
             its.ns
@@ -195,7 +224,7 @@ impl ShadingPoint {
             }
         } else if closure.normal == Vec3::ZERO
             && n.dot(-d) < 0.0
-            && (its.face_normal().dot(-d) < 0.0 || !keeps_turned_normal(&bsdf))
+            && (its.face_normal().dot(-d) < 0.0 || !keeps_turned_normal(bsdf))
         {
             // The interpolated normal turned away from the viewer is flipped with the face
             // when the face is seen from behind, as Cycles' N; like a closure's own normal it
@@ -216,7 +245,7 @@ impl ShadingPoint {
         } else {
             its.ng
         };
-        if raise && raises_specular_normal(&bsdf) {
+        if raise && raises_specular_normal(bsdf) {
             // Specular lobes (Glossy, Glass, Refraction, metallic or transmissive Principled)
             // under a normal or bump map reflect above the geometric surface, as Cycles makes
             // them; a transmissive lobe's normal is raised on the viewer's side.
@@ -240,7 +269,7 @@ impl ShadingPoint {
             None => Frame::from_normal(n),
         };
         let frame = frame_of(n);
-        let glossy_frame = (raise && specular_over_diffuse(&bsdf))
+        let glossy_frame = (raise && specular_over_diffuse(bsdf))
             .then(|| {
                 let m = bsdf::closure::valid_specular_normal(ng_seen, -d, n);
                 (m != n).then(|| frame_of(m))
@@ -258,24 +287,21 @@ impl ShadingPoint {
             if ns.dot(-d) < 0.0 { -ns } else { ns }
         });
         let wi = frame.to_local(-d);
-        let mut bsdf = bsdf;
-        if let BsdfInstance::Layered(l) = &mut bsdf {
+        if let BsdfInstance::Layered(l) = &mut self.bsdf {
             // The layering for the direction its top lobe is queried with.
             l.prepare(glossy_frame.as_ref().map_or(wi, |g| g.to_local(-d)));
         }
-        Some(ShadingPoint {
-            smooth,
-            glossy_frame,
-            passes: matches!(
-                closure.kind,
-                crate::shading::ClosureKind::Transparent { .. }
-            ),
-            bsdf,
-            wi,
-            frame,
-            weight: closure.weight * (inv_p * share),
-            subsurface: None,
-        })
+        self.smooth = smooth;
+        self.glossy_frame = glossy_frame;
+        self.passes = matches!(
+            closure.kind,
+            crate::shading::ClosureKind::Transparent { .. }
+        );
+        self.wi = wi;
+        self.frame = frame;
+        self.weight = closure.weight * (inv_p * share);
+        self.subsurface = None;
+        true
     }
 
     /// The shading point of a path entering the surface at `its` (seen along the unit `d`)

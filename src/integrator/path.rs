@@ -191,6 +191,7 @@ impl PathMats {
         ctx.blur = 0.0;
         ctx.walks_subsurface = true;
         ctx.medium = scene.camera_medium;
+        let mut sp = ShadingPoint::unshaded();
         loop {
             // Inside an interior the segment's length is needed: no shortcut.
             let last = depth >= end && ctx.medium.is_clear();
@@ -243,9 +244,9 @@ impl PathMats {
             if BLUR {
                 ctx.blur = self.paths.filter_glossy.roughness(min_ray_pdf);
             }
-            let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
+            if !sp.shade(scene, ctx, &its, d, depth) {
                 return l;
-            };
+            }
             if sp.passes {
                 // Straight through a transparent closure: not a bounce (Cycles counts these
                 // separately, up to its default of 8).
@@ -350,6 +351,7 @@ impl PathMis {
         ctx.blur = 0.0;
         ctx.walks_subsurface = true;
         ctx.medium = scene.camera_medium;
+        let mut sp = ShadingPoint::unshaded();
         loop {
             // Inside an interior the segment's length is needed: no shortcut.
             let last = depth >= end && ctx.medium.is_clear();
@@ -415,9 +417,9 @@ impl PathMis {
             if BLUR {
                 ctx.blur = self.paths.filter_glossy.roughness(min_ray_pdf);
             }
-            let Some(sp) = ShadingPoint::new(scene, ctx, &its, d, depth) else {
+            if !sp.shade(scene, ctx, &its, d, depth) {
                 return l;
-            };
+            }
             if sp.passes {
                 // Straight through a transparent closure: not a bounce (Cycles counts these
                 // separately, up to its default of 8).
