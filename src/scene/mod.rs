@@ -392,6 +392,9 @@ pub struct Material {
     pub graph: Option<Arc<crate::shading::Graph>>,
     /// Blender's material pass index (the Material Index pass).
     pub pass_index: u32,
+    /// `KHR_materials_unlit`: the base colour shown unshaded to the camera (see
+    /// [`crate::shading::preset`]).
+    pub unlit: bool,
 }
 
 impl Default for Material {
@@ -426,6 +429,7 @@ impl Default for Material {
             volume: None,
             graph: None,
             pass_index: 0,
+            unlit: false,
         }
     }
 }

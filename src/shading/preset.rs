@@ -119,6 +119,54 @@ impl Builder<'_> {
         self.mul(Val::Const(factor.to_vec()), v, which.is_some())
     }
 
+    /// Base colour (factor × texture × COLOR_0) and, unless the material is opaque, alpha
+    /// (likewise; MASK turns it into exactly 0 or 1 at the cutoff).
+    fn base_color_and_alpha(&mut self, m: &Material) -> (Val, Option<Val>) {
+        let base_img = m
+            .base_color_texture
+            .as_ref()
+            .and_then(|t| self.image(t, true));
+        let mut base = match base_img {
+            Some(img) => self.mul(
+                Val::Const(m.base_color.to_array().to_vec()),
+                Val::Link(img, "Color"),
+                false,
+            ),
+            None => Val::Const(m.base_color.to_array().to_vec()),
+        };
+        let vcol = m.vertex_color.then(|| {
+            self.g
+                .add(Node::new("ShaderNodeVertexColor").prop("layer_name", json!("")))
+        });
+        if let Some(vc) = vcol {
+            base = self.mul(base, Val::Link(vc, "Color"), false);
+        }
+        if m.alpha_mode == AlphaMode::Opaque {
+            return (base, None);
+        }
+        let mut alpha = Val::Const(vec![m.alpha]);
+        if let Some(img) = base_img {
+            alpha = self.mul(alpha, Val::Link(img, "Alpha"), true);
+        }
+        if let Some(vc) = vcol {
+            alpha = self.mul(alpha, Val::Link(vc, "Alpha"), true);
+        }
+        if let AlphaMode::Mask { cutoff } = m.alpha_mode {
+            alpha = match alpha {
+                Val::Const(a) => Val::Const(vec![if a[0] >= cutoff { 1.0 } else { 0.0 }]),
+                link => {
+                    let n = set(
+                        Node::new("TeselaAlphaCutoff").prop("cutoff", json!(cutoff)),
+                        "Alpha",
+                        link,
+                    );
+                    Val::Link(self.g.add(n), "Alpha")
+                }
+            };
+        }
+        (base, Some(alpha))
+    }
+
     /// A tangent-space normal map of texture `t` with glTF's `scale`.
     fn normal_map(&mut self, t: &TexRef, scale: f32) -> Option<usize> {
         let img = self.image(t, false)?;
@@ -146,6 +194,9 @@ pub fn metallic_roughness(m: &Material, textures: &[Texture]) -> Graph {
         g: Graph::default(),
         textures,
     };
+    if m.unlit {
+        return unlit(b, m);
+    }
     let mut principled = Node::new("ShaderNodeBsdfPrincipled")
         .prop("gltf", json!(true))
         .with("Metallic", &[m.metallic])
@@ -154,44 +205,9 @@ pub fn metallic_roughness(m: &Material, textures: &[Texture]) -> Graph {
         .with("Transmission Weight", &[m.transmission])
         .with("Specular IOR Level", &[m.specular * 0.5])
         .with("Specular Tint", &m.specular_color.to_array());
-    // Base colour and alpha.
-    let base_img = m.base_color_texture.as_ref().and_then(|t| b.image(t, true));
-    let mut base = match base_img {
-        Some(img) => b.mul(
-            Val::Const(m.base_color.to_array().to_vec()),
-            Val::Link(img, "Color"),
-            false,
-        ),
-        None => Val::Const(m.base_color.to_array().to_vec()),
-    };
-    let vcol = m.vertex_color.then(|| {
-        b.g.add(Node::new("ShaderNodeVertexColor").prop("layer_name", json!("")))
-    });
-    if let Some(vc) = vcol {
-        base = b.mul(base, Val::Link(vc, "Color"), false);
-    }
+    let (base, alpha) = b.base_color_and_alpha(m);
     principled = set(principled, "Base Color", base);
-    if m.alpha_mode != AlphaMode::Opaque {
-        let mut alpha = Val::Const(vec![m.alpha]);
-        if let Some(img) = base_img {
-            alpha = b.mul(alpha, Val::Link(img, "Alpha"), true);
-        }
-        if let Some(vc) = vcol {
-            alpha = b.mul(alpha, Val::Link(vc, "Alpha"), true);
-        }
-        if let AlphaMode::Mask { cutoff } = m.alpha_mode {
-            alpha = match alpha {
-                Val::Const(a) => Val::Const(vec![if a[0] >= cutoff { 1.0 } else { 0.0 }]),
-                link => {
-                    let n = set(
-                        Node::new("TeselaAlphaCutoff").prop("cutoff", json!(cutoff)),
-                        "Alpha",
-                        link,
-                    );
-                    Val::Link(b.g.add(n), "Alpha")
-                }
-            };
-        }
+    if let Some(alpha) = alpha {
         principled = set(principled, "Alpha", alpha);
     }
     if let Some(img) = m
@@ -302,5 +318,37 @@ pub fn metallic_roughness(m: &Material, textures: &[Texture]) -> Graph {
     }
     let p = b.g.add(principled);
     b.g.surface = Some((p, "BSDF".into()));
+    b.g
+}
+
+/// `KHR_materials_unlit`, as Blender's glTF importer builds it (so that a file renders as the
+/// same file imported into Blender and rendered by Cycles): the base colour is emitted with
+/// strength 1 to camera rays, and every other ray passes through (Light Path's Is Camera Ray
+/// mixing a Transparent BSDF and the Emission), so the surface shows its colour unshaded and
+/// neither lights, shadows nor reflects. Alpha (BLEND, MASK) mixes in a Transparent BSDF.
+fn unlit(mut b: Builder, m: &Material) -> Graph {
+    let (base, alpha) = b.base_color_and_alpha(m);
+    let emission = set(
+        Node::new("ShaderNodeEmission").with("Strength", &[1.0]),
+        "Color",
+        base,
+    );
+    let emission = b.g.add(emission);
+    let path = b.g.add(Node::new("ShaderNodeLightPath"));
+    let clear =
+        b.g.add(Node::new("ShaderNodeBsdfTransparent").with("Color", &[1.0; 3]));
+    let mut out = b.g.add(
+        Node::new("ShaderNodeMixShader")
+            .link("Fac", path, "Is Camera Ray")
+            .link("Shader", clear, "BSDF")
+            .link("Shader_001", emission, "Emission"),
+    );
+    if let Some(alpha) = alpha {
+        let mix = set(Node::new("ShaderNodeMixShader"), "Fac", alpha)
+            .link("Shader", clear, "BSDF")
+            .link("Shader_001", out, "Shader");
+        out = b.g.add(mix);
+    }
+    b.g.surface = Some((out, "Shader".into()));
     b.g
 }

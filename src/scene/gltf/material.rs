@@ -310,6 +310,7 @@ impl<'a> Loader<'a> {
             volume,
             graph,
             pass_index,
+            unlit: extension(raw, "KHR_materials_unlit").is_some(),
         })
     }
 
