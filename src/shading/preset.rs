@@ -1,5 +1,6 @@
 //! The glTF metallic-roughness material as a node graph: foreign glTF files and Blender
-//! scenes take the same shading path.
+//! scenes take the same shading path, Cycles' Principled BSDF, so a file renders as it does
+//! imported into Blender and rendered by Cycles.
 //!
 //! Every factor multiplies its texture (glTF's rule), each texture reads its own `texCoord`
 //! set through its `KHR_texture_transform`; the result feeds a Principled BSDF, the way
@@ -198,7 +199,6 @@ pub fn metallic_roughness(m: &Material, textures: &[Texture]) -> Graph {
         return unlit(b, m);
     }
     let mut principled = Node::new("ShaderNodeBsdfPrincipled")
-        .prop("gltf", json!(true))
         .with("Metallic", &[m.metallic])
         .with("Roughness", &[m.roughness])
         .with("IOR", &[m.ior])

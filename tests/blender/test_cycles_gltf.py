@@ -35,10 +35,11 @@ SIZE = 64  # every render here is SIZE x SIZE
 # helpers
 
 
-def run_tesela(binary, gltf, out, integrator, spp, max_depth, width=SIZE, height=SIZE, seed=1):
+def run_tesela(binary, gltf, out, integrator, spp, max_depth, width=SIZE, height=SIZE, seed=1,
+               extra=()):
     cmd = [str(binary), "render", str(gltf), "-o", str(out), "--integrator", integrator,
            "--spp", str(spp), "--max-depth", str(max_depth), "--width", str(width),
-           "--height", str(height), "--seed", str(seed), "--quiet"]
+           "--height", str(height), "--seed", str(seed), "--quiet", *extra]
     threads = os.environ.get("TESELA_TEST_THREADS")
     if threads:
         cmd += ["--threads", threads]
