@@ -3,6 +3,8 @@ the ``tesela`` CLI on the file against Cycles on the same file imported into Ble
 own importer (``import_scene.gltf``), which is what an artist who brings the asset into Blender
 sees.
 
+- ``EXT_texture_webp`` (gltfpack, three.js, web pipelines): textures whose only image is a WebP
+  file, the extension required.
 - ``KHR_materials_unlit`` (three.js's MeshBasicMaterial, Sketchfab's shadeless assets, baked
   lighting): Blender's importer makes the base colour an Emission of strength 1 seen by camera
   rays only, every other ray passing through, so the surface shows its colour flat and casts no
@@ -127,6 +129,28 @@ class GltfBuilder:
             {"source": len(self.doc["images"]) - 1, "sampler": len(self.doc["samplers"]) - 1})
         return len(self.doc["textures"]) - 1
 
+    def webp_texture(self, rgba, tmp_path):
+        """An embedded WebP image (written by Blender) as the only source of a texture
+        (``EXT_texture_webp``, required), with a nearest sampler."""
+        h, w, _ = rgba.shape
+        img = bpy.data.images.new("webp", w, h, alpha=True)
+        img.pixels.foreach_set((rgba[::-1] / 255.0).astype(np.float32).ravel())
+        path = tmp_path / "texture.webp"
+        img.filepath_raw, img.file_format = str(path), "WEBP"
+        img.save()
+        bpy.data.images.remove(img)
+        data = path.read_bytes()
+        assert data[8:12] == b"WEBP", "Blender did not write a WebP file"
+        self.doc.setdefault("images", []).append(
+            {"uri": "data:image/webp;base64," + base64.b64encode(data).decode()})
+        self.doc.setdefault("samplers", []).append({"magFilter": 9728, "minFilter": 9728})
+        self.doc.setdefault("textures", []).append(
+            {"sampler": len(self.doc["samplers"]) - 1,
+             "extensions": {"EXT_texture_webp": {"source": len(self.doc["images"]) - 1}}})
+        self.used.add("EXT_texture_webp")
+        self.doc.setdefault("extensionsRequired", []).append("EXT_texture_webp")
+        return len(self.doc["textures"]) - 1
+
     def camera(self, eye, target, yfov):
         """A perspective camera at ``eye`` looking at ``target`` (glTF: it looks along -Z)."""
         eye, target = np.asarray(eye, float), np.asarray(target, float)
@@ -196,6 +220,31 @@ def unlit_scene():
     return g
 
 
+def webp_scene(tmp_path):
+    """A box and a standing card textured from WebP images only: an opaque colour grid on the
+    box, and a card whose cut-out cells come from the WebP's alpha (MASK)."""
+    g = stage()
+    grid = np.zeros((8, 8, 4), np.uint8)
+    for y in range(8):
+        for x in range(8):
+            grid[y, x] = (40 + 26 * x, 200 - 20 * y, 90 + 15 * ((x + y) % 4), 255)
+    boxmat = g.material({"name": "WebpBox", "pbrMetallicRoughness": {
+        "baseColorTexture": {"index": g.webp_texture(grid, tmp_path)},
+        "metallicFactor": 0.0, "roughnessFactor": 0.7}})
+    g.box("WebpBox", (0.45, 0.45, 0.45), boxmat, (-0.5, 0.45, 0.3))
+    cells = np.zeros((4, 4, 4), np.uint8)
+    for y in range(4):
+        for x in range(4):
+            cells[y, x] = (230, 120, 30, 255) if (x + y) % 2 == 0 else (30, 30, 30, 0)
+    card = g.material({"name": "WebpCard", "alphaMode": "MASK", "doubleSided": True,
+                       "pbrMetallicRoughness": {"baseColorTexture": {
+                           "index": g.webp_texture(cells, tmp_path)},
+                           "metallicFactor": 0.0}})
+    g.quad("WebpCard", [(0.3, 0.0, 0.0), (1.5, 0.0, 0.0), (1.5, 1.2, 0.0), (0.3, 1.2, 0.0)],
+           card)
+    return g
+
+
 def cycles_of_import(gltf, tmp_path, spp, bounces, world=None):
     """The file imported by Blender's importer into an empty scene, rendered by Cycles through
     the file's camera; the world black or of constant radiance ``world`` (RGB)."""
@@ -210,13 +259,13 @@ def cycles_of_import(gltf, tmp_path, spp, bounces, world=None):
     return imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
 
 
-CASES = [("unlit", unlit_scene)]
+CASES = [("unlit", lambda tmp_path: unlit_scene()), ("webp", webp_scene)]
 
 
 @pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
 def test_file_agrees_with_cycles_import(tesela_bin, tmp_path, case):
     name, build = case
-    gltf = build().write(tmp_path / f"{name}.gltf")
+    gltf = build(tmp_path).write(tmp_path / f"{name}.gltf")
     spp, bounces = 256, 4
     ref = cycles_of_import(gltf, tmp_path, spp, bounces)
     assert ref[..., :3].mean() > 0.01, "the Cycles reference is black: the scene is broken"

@@ -14,10 +14,14 @@ use crate::scene::{AlphaMode, Image, Material, TexRef, Texture, UvTransform, Wra
 /// Largest accepted image side, in pixels.
 const MAX_IMAGE_SIDE: u32 = super::image_file::MAX_SIDE;
 
-/// Decodes PNG or JPEG bytes into RGBA8, rows top to bottom.
+/// Decodes PNG, JPEG or WebP (`EXT_texture_webp`) bytes into RGBA8, rows top to bottom.
 pub(crate) fn decode_image(bytes: &[u8]) -> Result<Image, String> {
-    use image::ImageFormat::{Jpeg, Png};
-    let img = super::image_file::read(bytes, &[Png, Jpeg], ("PNG and JPEG", "a PNG or JPEG"))?;
+    use image::ImageFormat::{Jpeg, Png, WebP};
+    let img = super::image_file::read(
+        bytes,
+        &[Png, Jpeg, WebP],
+        ("PNG, JPEG and WebP", "a PNG, JPEG or WebP"),
+    )?;
     Ok(super::image_file::bytes_image(&img))
 }
 
@@ -784,7 +788,7 @@ impl<'a> Loader<'a> {
             }
         }
         let raw_texture = self.raw_item("textures", ti);
-        if raw_texture.is_object() && member(raw_texture, "source").is_none() {
+        if raw_texture.is_object() && self.texture_source(ti).is_none() {
             self.warn_once(format!(
                 "texture {ti} has no `source` (only an extension's image format); material {gi} {slot} is left untextured"
             ));
@@ -800,6 +804,15 @@ impl<'a> Loader<'a> {
         }))
     }
 
+    /// The image texture `ti` reads: `EXT_texture_webp`'s source when it has one (the
+    /// extension's rule: a client that decodes WebP prefers it), else `source`, the fallback.
+    fn texture_source(&self, ti: usize) -> Option<usize> {
+        let raw = self.raw_item("textures", ti);
+        let index = |v: Option<&Value>| v.and_then(Value::as_u64).map(|i| i as usize);
+        index(extension(raw, "EXT_texture_webp").and_then(|e| member(e, "source")))
+            .or_else(|| index(member(raw, "source")))
+    }
+
     fn texture(&mut self, ti: usize) -> Result<usize, LoadError> {
         if let Some(&t) = self.textures.get(&ti) {
             return Ok(t);
@@ -810,14 +823,14 @@ impl<'a> Loader<'a> {
                 self.root.textures.len()
             ))
         })?;
-        if member(self.raw_item("textures", ti), "source").is_none() {
+        let Some(source) = self.texture_source(ti) else {
             return Err(LoadError::new(
                 LoadErrorKind::Unsupported,
                 format!(
                     "texture {ti} has no `source` (only an extension's image format, which is not supported)"
                 ),
             ));
-        }
+        };
         let (wrap_s, wrap_t, nearest) = match t.sampler {
             Some(si) => {
                 let s = self.root.samplers.get(si.value()).ok_or_else(|| {
@@ -836,7 +849,7 @@ impl<'a> Loader<'a> {
             None => (Wrap::Repeat, Wrap::Repeat, false),
         };
         let image = self
-            .image(t.source.value())
+            .image(source)
             .map_err(|e| LoadError::new(e.kind, format!("texture {ti}: {}", e.message)))?;
         self.scene.textures.push(Texture {
             image,

@@ -722,6 +722,59 @@ fn texture_transform_is_read_and_samplers_shared() {
     assert_eq!(s.images[0].rgba8, vec![[10, 20, 30, 255]; 2]);
 }
 
+/// A data URI of a 2x1 image of one colour in `format`.
+fn image_uri(rgba: [u8; 4], format: image::ImageFormat, mime: &str) -> String {
+    let mut bytes = Vec::new();
+    image::RgbaImage::from_pixel(2, 1, image::Rgba(rgba))
+        .write_to(&mut std::io::Cursor::new(&mut bytes), format)
+        .unwrap();
+    format!(
+        "data:{mime};base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&bytes)
+    )
+}
+
+#[test]
+fn webp_textures_are_preferred_to_their_fallback_and_unlit_is_understood() {
+    let mut b = Bin::default();
+    let p = b.vec3(&[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]]);
+    let uv = b.floats(&[0., 0., 1., 0., 0., 1.], "VEC2");
+    let png = image_uri([200, 0, 0, 255], image::ImageFormat::Png, "image/png");
+    let webp = image_uri([0, 0, 200, 255], image::ImageFormat::WebP, "image/webp");
+    let webp_only = image_uri([0, 150, 0, 255], image::ImageFormat::WebP, "image/webp");
+    let bytes = b.finish(json!({
+        "extensionsUsed": ["EXT_texture_webp", "KHR_materials_unlit"],
+        "nodes": [{ "mesh": 0 }, { "mesh": 1 }],
+        "images": [{ "uri": png }, { "uri": webp }, { "uri": webp_only }],
+        "textures": [
+            { "source": 0, "extensions": { "EXT_texture_webp": { "source": 1 } } },
+            { "extensions": { "EXT_texture_webp": { "source": 2 } } }
+        ],
+        "materials": [
+            { "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 } } },
+            { "pbrMetallicRoughness": { "baseColorTexture": { "index": 1 } },
+              "extensions": { "KHR_materials_unlit": {} } }
+        ],
+        "meshes": [
+            { "primitives": [{ "attributes": { "POSITION": p, "TEXCOORD_0": uv }, "material": 0 }] },
+            { "primitives": [{ "attributes": { "POSITION": p, "TEXCOORD_0": uv }, "material": 1 }] }
+        ]
+    }));
+    let s = load(&bytes);
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let texel = |m: usize| {
+        let t = s.materials[m].base_color_texture.unwrap().texture;
+        s.images[s.textures[t].image].rgba8[0]
+    };
+    assert_eq!(
+        texel(0),
+        [0, 0, 200, 255],
+        "the WebP source, not the PNG fallback"
+    );
+    assert_eq!(texel(1), [0, 150, 0, 255], "a WebP-only texture");
+    assert!(!s.materials[0].unlit && s.materials[1].unlit);
+}
+
 #[test]
 fn scenes_without_nodes_and_empty_documents() {
     for doc in [
