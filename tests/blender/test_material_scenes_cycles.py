@@ -788,6 +788,20 @@ def principled_variant(kind):
             # 4 cm against its 60 cm radius), which glows through where the sun does not reach.
             ins.update(Base_Color=(0.8, 0.6, 0.5, 1.0), Subsurface_Weight=1.0,
                        Subsurface_Radius=(1.0, 0.4, 0.2), Subsurface_Scale=0.5)
+        elif kind == "sheen_over_coat":
+            # Velvet-like sheen over a coat over the dielectric base (specular over diffuse):
+            # three layers, as Cycles stacks them.
+            ins.update(Base_Color=(0.1, 0.03, 0.03, 1.0), Coat_Weight=1.0, Coat_Roughness=0.2,
+                       Sheen_Weight=1.0, Sheen_Roughness=0.3, Sheen_Tint=(0.9, 0.9, 1.0, 1.0))
+        elif kind == "emission_coat_sheen":
+            # Cycles sets the emission up below the sheen and the coat: their albedo for the
+            # view direction, and the coat's tint along the view ray refracted into it, take
+            # their share (a glowing ball under a blue coat glows bluish, darker at its rim).
+            # Its light samples see the tint alone (Cycles evaluates them without closures), as
+            # do rays that end at the ball: with 2 bounces the floor's rays go on from it.
+            ins.update(Base_Color=(0.05, 0.05, 0.05, 1.0), Emission_Color=(1.0, 0.7, 0.4, 1.0),
+                       Emission_Strength=3.0, Coat_Weight=1.0, Coat_Roughness=0.2,
+                       Coat_Tint=(0.4, 0.7, 1.0, 1.0), Sheen_Weight=1.0, Sheen_Roughness=0.3)
         elif kind.startswith("thin_film"):
             # Interference colours that change across the ball with the angle of incidence;
             # a dark base so that the specular layer carries them.
@@ -1183,6 +1197,9 @@ CASES = [
     ("emitter_hidden_from_camera", emitter_hidden_from_camera, 2, 256, 1024),
     ("principled_coat", principled_variant("coat"), 0, 256, 1024),
     ("principled_sheen", principled_variant("sheen"), 0, 256, 1024),
+    ("principled_sheen_over_coat", principled_variant("sheen_over_coat"), 0, 256, 1024),
+    ("principled_emission_under_coat_and_sheen", principled_variant("emission_coat_sheen"),
+     2, 256, 1024),
     ("wireframe_ball", wireframe_ball, 0, 128, 512),
     ("ambient_occlusion_floor", ambient_occlusion(), 2, 128, 512),
     ("ambient_occlusion_inside_local", ambient_occlusion(True), 0, 128, 512),

@@ -60,6 +60,11 @@ pub struct PrincipledSlots {
     emission_strength: Slot,
     cycles: bool,
     multiscatter: bool,
+    /// The emission may be on under a coat or sheen, which attenuate it by the view direction.
+    layered_emission: bool,
+    /// A sheen may lie over a coat: the sheen becomes a closure of its own, above the rest
+    /// weighted by what it lets through for the view direction.
+    sheen_over_coat: bool,
 }
 
 /// How a Metallic BSDF gives its reflectance.
@@ -266,7 +271,10 @@ impl ClosureOp {
                         ClosureKind::Transparent { color: Vec3::ONE },
                     );
                 }
-                out.add_emission(col(p.emission_color) * s.f(p.emission_strength) * wb);
+                let emission = col(p.emission_color) * s.f(p.emission_strength) * wb;
+                if emission != Vec3::ZERO {
+                    out.add_emission(emission * principled_emission_layers(s, p, g));
+                }
                 let pr = Principled {
                     base_color: col(p.base),
                     metallic: s.f(p.metallic).clamp(0.0, 1.0),
@@ -301,13 +309,16 @@ impl ClosureOp {
                     cycles: p.cycles,
                     multiscatter: p.multiscatter,
                 };
-                push(
-                    out,
-                    Vec3::splat(wb),
-                    normal(p.normal),
-                    tangent(p.tangent),
-                    ClosureKind::Principled(pr),
-                );
+                let n = normal(p.normal);
+                let mut pr = pr;
+                let mut wb = Vec3::splat(wb);
+                if let Some((sheen, sheen_weight, below)) =
+                    sheen_apart(&mut pr, n, g).filter(|_| p.sheen_over_coat)
+                {
+                    push(out, wb * sheen_weight, n, Vec3::ZERO, sheen);
+                    wb *= below;
+                }
+                push(out, wb, n, tangent(p.tangent), ClosureKind::Principled(pr));
             }
             ClosureParams::Metallic {
                 fresnel,
@@ -614,6 +625,102 @@ fn physical_as_f82(eta: Vec3, k: Vec3) -> (Vec3, Vec3) {
     (f0, tint)
 }
 
+/// A Blender Principled BSDF's sheen over its coat as a closure of its own, as Cycles sets it
+/// up (the layered BSDF holds a sheen over a coat over a diffuse or metal base only): removes
+/// the sheen from `pr` and returns the sheen closure, its weight factor and the factor
+/// `1 - max(sheen albedo)` on the closures below, both for the view direction about the
+/// closure normal `n` (renderer world space; zero for the shading normal). The sheen closure
+/// carries its albedo in its weight and the sheen divided by it, so that the closure choice
+/// picks it as often as it reflects. `None` without both layers, or for a view from below.
+fn sheen_apart(pr: &mut Principled, n: Vec3, g: &ShaderGlobals) -> Option<(ClosureKind, f32, f32)> {
+    use crate::bsdf::Sheen;
+    if !(pr.coat_weight > 0.0 && pr.sheen_weight > 0.0) || pr.sheen_tint.max_element() <= 0.0 {
+        return None;
+    }
+    let n = if n == Vec3::ZERO {
+        from_blender(g.n)
+    } else {
+        n
+    };
+    let mu = n.dot(from_blender(g.i)).min(1.0);
+    let tint = pr.sheen_tint * pr.sheen_weight;
+    let wi = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+    let e = Sheen::new(Vec3::ONE, pr.sheen_roughness).albedo(wi).x;
+    if !(e > 0.0 && e.is_finite()) {
+        return None;
+    }
+    let below = (1.0 - tint.max_element() * e).clamp(0.0, 1.0);
+    let sheen = Principled {
+        sheen_weight: 1.0 / e,
+        sheen_roughness: pr.sheen_roughness,
+        sheen_tint: tint,
+        multiscatter: pr.multiscatter,
+        ..Principled::lobe_only()
+    };
+    pr.sheen_weight = 0.0;
+    Some((ClosureKind::Principled(sheen), e, below))
+}
+
+/// The share of a Principled BSDF's emission that leaves through its sheen and coat, as Cycles
+/// sets the emission closure up below those layers (`principled` in `svm/closure.h`): each
+/// layer's `closure_layering_weight` for the view direction (Cycles' `wi`), the sheen about
+/// the Normal turned towards the coat normal by the coat weight, the coat about its normal
+/// (the Coat Normal, else the shading normal, made a valid specular one), and the coat's tint
+/// along the view direction refracted into it. Cycles evaluates the emission of its light
+/// samples without closures, so that the layers' albedos are not found there: a light sample
+/// (no ray bits) takes the tint alone. Blender world space, as the slots.
+fn principled_emission_layers(s: &Slots, p: &PrincipledSlots, g: &ShaderGlobals) -> Vec3 {
+    use crate::bsdf::{Coat, Layer, Sheen};
+    if !p.layered_emission {
+        return Vec3::ONE;
+    }
+    let closures = g.ray_flags != 0;
+    let unit = |slot: Option<Slot>| {
+        slot.and_then(|n| s.v(n).try_normalize())
+            .filter(|n| n.is_finite())
+            .unwrap_or(g.n)
+    };
+    // The direction towards the viewer in a frame about a unit normal (the layers are
+    // isotropic: only the cosine counts).
+    let towards_viewer = |n: Vec3| {
+        let mu = n.dot(g.i).clamp(-1.0, 1.0);
+        Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu)
+    };
+    let n = unit(p.normal);
+    let coat_n = unit(p.coat_normal);
+    let coat_weight = s.f(p.coat_weight).max(0.0);
+    let mut att = Vec3::ONE;
+    let sheen_tint = s.v(p.sheen_tint).max(Vec3::ZERO);
+    let sheen_weight = s.f(p.sheen_weight).max(0.0);
+    if closures && sheen_weight > 0.0 && sheen_tint.max_element() > 0.0 {
+        let sheen_n = n
+            .lerp(coat_n, coat_weight.min(1.0))
+            .try_normalize()
+            .unwrap_or(n);
+        let sheen = Sheen::new(
+            sheen_tint * sheen_weight,
+            s.f(p.sheen_roughness).clamp(0.0, 1.0),
+        );
+        att *= sheen.attenuation(towards_viewer(sheen_n));
+    }
+    if coat_weight > 0.0 {
+        let coat_n = crate::bsdf::closure::valid_specular_normal(g.ng, g.i, coat_n);
+        let tint = s.v(p.coat_tint).max(Vec3::ZERO);
+        if closures {
+            let coat = Coat::new(coat_weight, s.f(p.coat_roughness), s.f(p.coat_ior), tint);
+            att *= coat.attenuation(towards_viewer(coat_n));
+        } else if tint != Vec3::ONE {
+            // Beer's law along the view direction refracted into a coat of unit thickness.
+            let mu = coat_n.dot(g.i).clamp(-1.0, 1.0);
+            let inv = 1.0 / s.f(p.coat_ior).max(1.0);
+            let cos_t = (1.0 - inv * inv * (1.0 - mu * mu)).max(0.0).sqrt();
+            let through = tint.powf(1.0 / cos_t);
+            att *= Vec3::ONE + (through - Vec3::ONE) * coat_weight;
+        }
+    }
+    att
+}
+
 /// A linked Normal input (Blender world space) as a unit world-space normal; zero (meaning
 /// "the shading normal") when it is degenerate.
 #[inline]
@@ -757,6 +864,8 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                 cycles: !cx.prop_bool("gltf", false),
                 // Blender 3.x and 4.x files keep GGX where it was chosen (3.x's default).
                 multiscatter: cx.prop_str("distribution").unwrap_or("MULTI_GGX") != "GGX",
+                layered_emission: false,
+                sheen_over_coat: false,
             };
             if cx.is_linked("Alpha") || cx.const_value("Alpha").is_some_and(|v| v[0] < 1.0) {
                 cx.passes();
@@ -770,8 +879,14 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                         v.iter().take(3).fold(f32::NEG_INFINITY, |m, &x| m.max(x))
                     }) > 1e-5
             };
+            let layer = |cx: &NodeCx, id: &str| {
+                p.cycles && (cx.is_linked(id) || cx.const_value(id).is_some_and(|v| v[0] > 0.0))
+            };
+            let (coat, sheen) = (layer(cx, "Coat Weight"), layer(cx, "Sheen Weight"));
+            p.sheen_over_coat = coat && sheen;
             if on(cx, "Emission Color", 1.0) && on(cx, "Emission Strength", 0.0) {
                 cx.emits();
+                p.layered_emission = coat || sheen;
             } else {
                 p.emission_strength = cx.constant(&[0.0])?;
             }
@@ -912,7 +1027,11 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
         }
         _ => return Ok(false),
     };
-    cx.emit(Op::Closure(ClosureOp { weight: w, params }), false);
+    // A Principled BSDF's emission under a coat or sheen, and a sheen over a coat, depend on
+    // the view direction.
+    let varying = matches!(&params,
+        ClosureParams::Principled(p) if p.layered_emission || p.sheen_over_coat);
+    cx.emit(Op::Closure(ClosureOp { weight: w, params }), varying);
     let _ = SocketType::Shader;
     Ok(true)
 }
