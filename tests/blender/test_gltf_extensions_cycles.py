@@ -52,14 +52,17 @@ class GltfBuilder:
     def _view(self, data, target):
         while len(self.blob) % 4:
             self.blob.append(0)
-        self.doc["bufferViews"].append({"buffer": 0, "byteOffset": len(self.blob),
-                                        "byteLength": len(data), "target": target})
+        view = {"buffer": 0, "byteOffset": len(self.blob), "byteLength": len(data)}
+        if target is not None:
+            view["target"] = target
+        self.doc["bufferViews"].append(view)
         self.blob += data
         return len(self.doc["bufferViews"]) - 1
 
-    def _accessor(self, array, kind, target):
+    def _accessor(self, array, kind, target=None):
         array = np.ascontiguousarray(array)
-        comp = 5126 if array.dtype == np.float32 else 5125
+        comp = {np.dtype(np.float32): 5126, np.dtype(np.uint32): 5125,
+                np.dtype(np.uint16): 5123}[array.dtype]
         acc = {"bufferView": self._view(array.tobytes(), target), "componentType": comp,
                "count": int(array.shape[0]), "type": kind}
         if kind == "VEC3" and comp == 5126:
@@ -74,15 +77,24 @@ class GltfBuilder:
             self.used.add(ext)
         return len(self.doc["materials"]) - 1
 
-    def mesh(self, name, positions, normals, uvs, indices, material, translation=(0, 0, 0)):
+    def mesh(self, name, positions, normals, uvs, indices, material, translation=(0, 0, 0),
+             skin=None):
+        """``skin``: (joints, weights) per vertex (4 each) and the skin index of the node."""
         attrs = {"POSITION": self._accessor(np.asarray(positions, np.float32), "VEC3", 34962),
                  "NORMAL": self._accessor(np.asarray(normals, np.float32), "VEC3", 34962),
                  "TEXCOORD_0": self._accessor(np.asarray(uvs, np.float32), "VEC2", 34962)}
+        if skin is not None:
+            joints, weights, _ = skin
+            attrs["JOINTS_0"] = self._accessor(np.asarray(joints, np.uint16), "VEC4", 34962)
+            attrs["WEIGHTS_0"] = self._accessor(np.asarray(weights, np.float32), "VEC4", 34962)
         ind = self._accessor(np.asarray(indices, np.uint32).reshape(-1), "SCALAR", 34963)
         self.doc["meshes"].append({"name": name, "primitives": [
             {"attributes": attrs, "indices": ind, "material": material}]})
-        self.doc["nodes"].append({"name": name, "mesh": len(self.doc["meshes"]) - 1,
-                                  "translation": list(translation)})
+        node = {"name": name, "mesh": len(self.doc["meshes"]) - 1,
+                "translation": list(translation)}
+        if skin is not None:
+            node["skin"] = skin[2]
+        self.doc["nodes"].append(node)
         self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
 
     def quad(self, name, corners, material, translation=(0, 0, 0)):
@@ -245,6 +257,52 @@ def webp_scene(tmp_path):
     return g
 
 
+def skinned_scene(tmp_path):
+    """A bent arm: a square tube along X whose outer half follows a second joint turned 50
+    degrees up, in the pose the joint nodes give (no animation); its mesh node carries a
+    translation that glTF says a skinned mesh ignores."""
+    g = stage()
+    arm = g.material({"name": "Arm", "pbrMetallicRoughness": {
+        "baseColorFactor": [0.7, 0.5, 0.3, 1.0], "metallicFactor": 0.0,
+        "roughnessFactor": 0.5}})
+    xs = np.linspace(-1.0, 1.0, 9)
+    h = 0.15
+    ring = [(-h, -h), (h, -h), (h, h), (-h, h)]  # (y, z) offsets about the axis
+    pos, nor, uv, joints, weights, ind = [], [], [], [], [], []
+    for side in range(4):
+        (y0, z0), (y1, z1) = ring[side], ring[(side + 1) % 4]
+        n = np.array([0.0, y0 + y1, z0 + z1])
+        n /= np.linalg.norm(n)
+        base = len(pos)
+        for x in xs:
+            w1 = float(np.clip((x + 0.25) / 0.5, 0.0, 1.0))  # joint 1 from x = -0.25 to 0.25
+            for y, z in ((y0, z0), (y1, z1)):
+                pos.append((x, 0.4 + y, z))
+                nor.append(n)
+                uv.append(((x + 1) / 2, side / 4))
+                joints.append((0, 1, 0, 0))
+                weights.append((1.0 - w1, w1, 0.0, 0.0))
+        for k in range(len(xs) - 1):
+            a, b = base + 2 * k, base + 2 * k + 2
+            ind += [a, b + 1, b, a, a + 1, b + 1]
+    first_joint = len(g.doc["nodes"])
+    g.doc["nodes"].append({"name": "Shoulder", "translation": [-1.0, 0.4, 0.0],
+                           "children": [first_joint + 1]})
+    c, s_ = math.cos(math.radians(25.0)), math.sin(math.radians(25.0))
+    g.doc["nodes"].append({"name": "Elbow", "translation": [1.0, 0.0, 0.0],
+                           "rotation": [0.0, 0.0, s_, c]})
+    g.doc["scenes"][0]["nodes"].append(first_joint)
+    inverse_bind = np.stack([np.eye(4), np.eye(4)]).astype(np.float32)
+    inverse_bind[0][:3, 3] = (1.0, -0.4, 0.0)   # the joints' bind poses: translations
+    inverse_bind[1][:3, 3] = (0.0, -0.4, 0.0)
+    ib = g._accessor(inverse_bind.transpose(0, 2, 1).reshape(-1, 16), "MAT4")
+    g.doc.setdefault("skins", []).append(
+        {"joints": [first_joint, first_joint + 1], "inverseBindMatrices": ib})
+    g.mesh("Arm", pos, nor, uv, ind, arm, translation=(3.0, 0.0, 0.0),
+           skin=(joints, weights, len(g.doc["skins"]) - 1))
+    return g
+
+
 def cycles_of_import(gltf, tmp_path, spp, bounces, world=None):
     """The file imported by Blender's importer into an empty scene, rendered by Cycles through
     the file's camera; the world black or of constant radiance ``world`` (RGB)."""
@@ -259,7 +317,8 @@ def cycles_of_import(gltf, tmp_path, spp, bounces, world=None):
     return imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
 
 
-CASES = [("unlit", lambda tmp_path: unlit_scene()), ("webp", webp_scene)]
+CASES = [("unlit", lambda tmp_path: unlit_scene()), ("webp", webp_scene),
+         ("skinned", skinned_scene)]
 
 
 @pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])

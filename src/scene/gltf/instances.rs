@@ -142,8 +142,24 @@ impl<'a> Loader<'a> {
             let own_weights = self.root.nodes[u.node].weights.is_some();
             let g = geometry[&u.mesh];
             let small = baked_size[&g] <= self.options.bake_triangles;
+            // A skinned mesh is posed by its joints, in world space, whatever its node says.
+            let skinning = self.skinning(u.node, u.world)?;
+            if let Some(s) = &skinning {
+                if !u.gpu.is_empty() {
+                    self.warn_once(format!(
+                        "node {}: a skinned mesh placed by EXT_mesh_gpu_instancing is drawn once, posed by its skin",
+                        u.node
+                    ));
+                }
+                let (baked, _) =
+                    self.instance_mesh(u.node, u.mesh, Mat4::IDENTITY, false, Some(s))?;
+                let origins = &mut self.origins.mesh_node;
+                origins.resize(baked.start, None);
+                origins.resize(baked.end, Some(u.node));
+                continue;
+            }
             if u.gpu.is_empty() && (placements[&g] == 1 || own_weights || small) {
-                let (baked, _) = self.instance_mesh(u.node, u.mesh, u.world, false)?;
+                let (baked, _) = self.instance_mesh(u.node, u.mesh, u.world, false, None)?;
                 let origins = &mut self.origins.mesh_node;
                 origins.resize(baked.start, None);
                 origins.resize(baked.end, Some(u.node));
@@ -152,7 +168,7 @@ impl<'a> Loader<'a> {
             let (owner, range, prims) = match stored.get(&g) {
                 Some(s) => s.clone(),
                 None => {
-                    let (r, p) = self.instance_mesh(u.node, u.mesh, Mat4::IDENTITY, true)?;
+                    let (r, p) = self.instance_mesh(u.node, u.mesh, Mat4::IDENTITY, true, None)?;
                     stored.insert(g, (u.mesh, r.clone(), p.clone()));
                     (u.mesh, r, p)
                 }

@@ -221,6 +221,7 @@ impl<'a> Loader<'a> {
         mi: usize,
         world: Mat4,
         object_space: bool,
+        skin: Option<&super::skin::Skinning>,
     ) -> Result<(std::ops::Range<usize>, Vec<usize>), LoadError> {
         let first = self.scene.meshes.len();
         let root = self.root;
@@ -232,7 +233,7 @@ impl<'a> Loader<'a> {
         })?;
         let node = &root.nodes[ni];
         let weights: Option<&[f32]> = node.weights.as_deref().or(mesh.weights.as_deref());
-        let cacheable = node.weights.is_none();
+        let cacheable = node.weights.is_none() && skin.is_none();
         let base_name = mesh
             .name
             .clone()
@@ -249,12 +250,15 @@ impl<'a> Loader<'a> {
                 if let Some(c) = self.prim_cache.get(&(mi, pi)) {
                     c.clone()
                 } else {
-                    let l = self.local_prim(mi, pi, prim, weights, &needs)?.map(Rc::new);
+                    let l = self
+                        .local_prim(mi, pi, prim, weights, skin, &needs)?
+                        .map(Rc::new);
                     self.prim_cache.insert((mi, pi), l.clone());
                     l
                 }
             } else {
-                self.local_prim(mi, pi, prim, weights, &needs)?.map(Rc::new)
+                self.local_prim(mi, pi, prim, weights, skin, &needs)?
+                    .map(Rc::new)
             };
             let (Some(local), Some(material)) = (local, material) else {
                 continue;
@@ -556,6 +560,7 @@ impl<'a> Loader<'a> {
         pi: usize,
         prim: &json::mesh::Primitive,
         weights: Option<&[f32]>,
+        skin: Option<&super::skin::Skinning>,
         needs: &Needs,
     ) -> Result<Option<LocalPrim>, LoadError> {
         let mode = match prim.mode {
@@ -763,6 +768,16 @@ impl<'a> Loader<'a> {
                     }
                 }
             }
+        }
+        if let Some(s) = skin {
+            self.skin_vertices(
+                prim,
+                (mi, pi),
+                s,
+                &mut positions,
+                &mut normals,
+                &mut tangents,
+            )?;
         }
         if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
             return Err(invalid(format!(

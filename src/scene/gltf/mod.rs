@@ -20,6 +20,7 @@ mod instances;
 mod lights;
 mod material;
 mod mesh;
+mod skin;
 mod tangents;
 mod uri;
 mod world;
@@ -256,8 +257,8 @@ fn load_parsed(
 }
 
 /// The typed document, deserialized by the `gltf` crate from a copy of the JSON that
-/// keeps only what the crate must check: extension and extras objects (read from the raw
-/// JSON instead), animations and skins (not used) are left out, and properties that glTF
+/// keeps only what the crate must check: extension and extras objects and skins (read from
+/// the raw JSON instead) and animations (not used) are left out, and properties that glTF
 /// makes optional but the crate requires get neutral values (`scene.nodes`, a texture's
 /// `source`, which [`Loader::texture`] checks in the raw JSON).
 fn typed_document(raw: &Value) -> Result<json::Root, LoadError> {

@@ -52,6 +52,7 @@ impl Bin {
             "SCALAR" => 1,
             "VEC2" => 2,
             "VEC3" => 3,
+            "MAT4" => 16,
             _ => 4,
         };
         let b: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
@@ -796,7 +797,7 @@ fn typed_errors_carry_a_json_path_and_unused_parts_are_not_checked() {
         "nodes": [{ "mesh": 0 }],
         "meshes": [{ "primitives": [{ "attributes": { "POSITION": p }, "material": 0 }] }],
         "materials": [{ "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 } } }],
-        "textures": [{ "extensions": { "EXT_texture_webp": { "source": 0 } } }],
+        "textures": [{ "extensions": { "KHR_texture_basisu": { "source": 0 } } }],
         "animations": [{ "channels": "garbage" }],
         "skins": [{ "joints": "garbage" }],
         "extras": { "anything": [1, 2, 3] }
@@ -821,4 +822,57 @@ fn typed_errors_carry_a_json_path_and_unused_parts_are_not_checked() {
         e.to_string().contains("nodes[0]: invalid type: string"),
         "{e}"
     );
+}
+
+/// A triangle skinned to two joints: vertex 0 on joint 0, vertex 1 on joint 1, vertex 2 half
+/// and half; `joints` and `weights` replace the defaults to make bad files.
+fn skinned_doc(joints: &[u8], weights: &[f32]) -> Vec<u8> {
+    let mut b = Bin::default();
+    let p = b.vec3(&[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]]);
+    let n = b.vec3(&[[0., 0., 1.]; 3]);
+    let j = b.add(joints, 5121, joints.len() / 4, "VEC4", false);
+    let w = b.floats(weights, "VEC4");
+    // Joint 1 binds at x = 1: its inverse bind matrix moves it back to the origin.
+    let mut ib = glam::Mat4::IDENTITY.to_cols_array().to_vec();
+    ib.extend(glam::Mat4::from_translation(Vec3::new(-1., 0., 0.)).to_cols_array());
+    let ib = b.floats(&ib, "MAT4");
+    let h = std::f32::consts::FRAC_1_SQRT_2;
+    b.finish(json!({
+        "scenes": [{ "nodes": [0, 1] }],
+        "nodes": [
+            { "mesh": 0, "skin": 0, "translation": [100, 0, 0] },
+            { "translation": [0, 0, 5], "children": [2] },
+            { "translation": [1, 0, 0], "rotation": [0, 0, h, h] }
+        ],
+        "skins": [{ "joints": [1, 2], "inverseBindMatrices": ib }],
+        "meshes": [{ "primitives": [{ "attributes": {
+            "POSITION": p, "NORMAL": n, "JOINTS_0": j, "WEIGHTS_0": w } }] }]
+    }))
+}
+
+#[test]
+fn skinned_meshes_take_the_pose_of_their_joints() {
+    let joints = [0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0];
+    let weights = [1., 0., 0., 0., 1., 0., 0., 0., 0.5, 0.5, 0., 0.];
+    let s = load(&skinned_doc(&joints, &weights));
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let p = &s.meshes[0].positions;
+    // Joint 0 moves by (0, 0, 5); joint 1 also turns 90 degrees about Z at x = 1; the mesh
+    // node's own translation (100, 0, 0) is not applied.
+    let expect = [
+        Vec3::new(0., 0., 5.),
+        Vec3::new(1., 0., 5.),
+        // Half of (0, 1, 5) by joint 0, half of (0, -1, 5), the point turned about (1, 0, 5).
+        (Vec3::new(0., 1., 5.) + Vec3::new(0., -1., 5.)) * 0.5,
+    ];
+    for (got, want) in p.iter().zip(expect) {
+        assert!(got.abs_diff_eq(want, 1e-5), "{got} != {want}");
+    }
+    // Bad skins are clear errors naming the accessor.
+    let bad_joint = [0, 0, 0, 0, 7, 0, 0, 0, 0, 1, 0, 0];
+    let e = load_from_slice(&skinned_doc(&bad_joint, &weights), None, "t.gltf").unwrap_err();
+    assert!(e.to_string().contains("names joint 7"), "{e}");
+    let nan = [1., 0., 0., 0., f32::NAN, 0., 0., 0., 0.5, 0.5, 0., 0.];
+    let e = load_from_slice(&skinned_doc(&joints, &nan), None, "t.gltf").unwrap_err();
+    assert!(e.to_string().contains("WEIGHTS_0"), "{e}");
 }
