@@ -172,6 +172,9 @@ _SIMPLE_PROP_TYPES = ("ENUM", "BOOLEAN", "INT", "FLOAT", "STRING")
 _SKIP_PROPS = {"bytecode", "bytecode_hash"}  # a Script node's compiled OSL: large, of no use
 MENU_SWITCH = "GeometryNodeMenuSwitch"  # shader trees use it too (Blender 4.5+)
 _MAX_DEPTH = 400           # link hops from the output; Blender forbids cycles, this guards anyway
+# Nodes Cycles does not compile (EEVEE only): it leaves them out with their links, so that the
+# inputs they feed keep their own values.
+_NOT_IN_CYCLES = {"ShaderNodeShaderToRGB"}
 _base_props = None
 
 
@@ -338,6 +341,11 @@ class MaterialGraph:
         """An input socket in group context `ctx` -> {"link": [i, out]}, a value, or None."""
         link = self._link_into(sock)
         if link is None:
+            return self._value(sock, ctx)
+        if link.from_node.bl_idname in _NOT_IN_CYCLES:
+            self.report(self.name, link.from_node,
+                        "EEVEE only: Cycles leaves it out, and the inputs it feeds keep their "
+                        "own values, as rendered here")
             return self._value(sock, ctx)
         if depth > _MAX_DEPTH:
             self.report(self.name, sock.node, "the node graph is too deep; input '%s' is cut"

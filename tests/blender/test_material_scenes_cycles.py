@@ -920,6 +920,25 @@ def toon_ball(component):
     return build
 
 
+def shader_to_rgb_toon():
+    """The EEVEE toon set-up: Diffuse -> Shader to RGB -> a Constant Color Ramp -> Emission.
+    Cycles leaves Shader to RGB out with its links, so the ramp reads its own Fac (0.6, not
+    the default 0.5: past the second stop at 0.55) and the ball glows blue all over."""
+    mat, nt, out = node_material("Toon")
+    dif = node(nt, "ShaderNodeBsdfDiffuse")
+    to_rgb = node(nt, "ShaderNodeShaderToRGB", Shader=dif.outputs[0])
+    ramp = node(nt, "ShaderNodeValToRGB")
+    ramp.color_ramp.interpolation = "CONSTANT"
+    ramp.color_ramp.elements[0].color = (0.9, 0.4, 0.1, 1.0)
+    ramp.color_ramp.elements[1].color = (0.2, 0.4, 0.9, 1.0)
+    ramp.color_ramp.elements[1].position = 0.55
+    ramp.inputs["Fac"].default_value = 0.6
+    nt.links.new(to_rgb.outputs["Color"], ramp.inputs["Fac"])
+    em = node(nt, "ShaderNodeEmission", Color=ramp.outputs["Color"])
+    surface(nt, out, em.outputs[0])
+    _sphere_stage(mat)
+
+
 def sheen_bsdf():
     """The Sheen BSDF added to a dark Diffuse: the fabric look."""
     mat, nt, out = node_material("Velvet")
@@ -1206,6 +1225,7 @@ CASES = [
     ("bevel_box_edges", bevel_box, 0, 256, 1024),
     ("toon_diffuse_ball", toon_ball("DIFFUSE"), 0, 128, 512),
     ("toon_glossy_ball", toon_ball("GLOSSY"), 0, 256, 1024),
+    ("shader_to_rgb_left_out", shader_to_rgb_toon, 0, 64, 256),
     ("metallic_bsdf_f82_anisotropic", metallic_bsdf("F82"), 0, 256, 1024),
     ("metallic_bsdf_physical_conductor", metallic_bsdf("PHYSICAL_CONDUCTOR"), 0, 256, 1024),
     # The Sheen BSDF is a sheen layer over a black base: it took the black-base bug's toll.
