@@ -395,6 +395,9 @@ pub struct Material {
     /// `KHR_materials_unlit`: the base colour shown unshaded to the camera (see
     /// [`crate::shading::preset`]).
     pub unlit: bool,
+    /// `KHR_materials_pbrSpecularGlossiness`'s texture when it varies the roughness: roughness
+    /// = 1 − glossinessFactor × its alpha.
+    pub glossiness_texture: Option<TexRef>,
 }
 
 impl Default for Material {
@@ -430,6 +433,7 @@ impl Default for Material {
             graph: None,
             pass_index: 0,
             unlit: false,
+            glossiness_texture: None,
         }
     }
 }

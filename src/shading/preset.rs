@@ -221,6 +221,22 @@ pub fn metallic_roughness(m: &Material, textures: &[Texture]) -> Graph {
         let mt = b.mul(Val::Const(vec![m.metallic]), Val::Link(sep, "Blue"), true);
         principled = set(set(principled, "Roughness", r), "Metallic", mt);
     }
+    if let Some(img) = m.glossiness_texture.as_ref().and_then(|t| b.image(t, true)) {
+        // KHR_materials_pbrSpecularGlossiness: roughness = 1 - glossiness x alpha.
+        let gloss = b.mul(
+            Val::Const(vec![1.0 - m.roughness]),
+            Val::Link(img, "Alpha"),
+            true,
+        );
+        let rough = set(
+            Node::new("ShaderNodeMath")
+                .prop("operation", json!("SUBTRACT"))
+                .with("Value", &[1.0]),
+            "Value_001",
+            gloss,
+        );
+        principled = principled.link("Roughness", b.g.add(rough), "Value");
+    }
     if let Some(n) = m
         .normal_texture
         .as_ref()

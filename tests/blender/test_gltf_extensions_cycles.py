@@ -317,18 +317,49 @@ def cycles_of_import(gltf, tmp_path, spp, bounces, world=None):
     return imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
 
 
-CASES = [("unlit", lambda tmp_path: unlit_scene()), ("webp", webp_scene),
-         ("skinned", skinned_scene)]
+def specular_glossiness_scene(tmp_path):
+    """KHR_materials_pbrSpecularGlossiness (older exporters, Sketchfab's legacy assets): a box
+    with diffuse and specular-glossiness textures (the gloss in the alpha, from glossy to
+    rough cells), and a card with factors only. The extension is required, as such files
+    often have no metallic-roughness fallback."""
+    g = stage()
+    ext = "KHR_materials_pbrSpecularGlossiness"
+    diffuse = np.zeros((4, 4, 4), np.uint8)
+    spec = np.zeros((4, 4, 4), np.uint8)
+    for y in range(4):
+        for x in range(4):
+            diffuse[y, x] = (180 - 30 * x, 90 + 30 * y, 60, 255)
+            spec[y, x] = ((40, 40, 40) if (x + y) % 2 else (200, 170, 90)) + (255 - 70 * x,)
+    box = g.material({"name": "SpecGlossBox", "extensions": {ext: {
+        "diffuseTexture": {"index": g.png_texture(diffuse)},
+        "specularGlossinessTexture": {"index": g.png_texture(spec)},
+        "glossinessFactor": 0.9}}})
+    g.box("SpecGlossBox", (0.45, 0.45, 0.45), box, (-0.5, 0.45, 0.3))
+    card = g.material({"name": "SpecGlossCard", "doubleSided": True, "extensions": {ext: {
+        "diffuseFactor": [0.2, 0.4, 0.8, 1.0], "specularFactor": [0.5, 0.45, 0.4],
+        "glossinessFactor": 0.6}}})
+    g.quad("SpecGlossCard", [(0.3, 0.0, 0.0), (1.5, 0.0, 0.0), (1.5, 1.2, 0.0), (0.3, 1.2, 0.0)],
+           card)
+    g.doc.setdefault("extensionsRequired", []).append(ext)
+    return g
+
+
+# (name, builder, world radiance or None for black)
+CASES = [("unlit", lambda tmp_path: unlit_scene(), None), ("webp", webp_scene, None),
+         ("skinned", skinned_scene, None),
+         ("specular_glossiness", specular_glossiness_scene, (0.3, 0.3, 0.33))]
 
 
 @pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
 def test_file_agrees_with_cycles_import(tesela_bin, tmp_path, case):
-    name, build = case
+    name, build, world = case
     gltf = build(tmp_path).write(tmp_path / f"{name}.gltf")
     spp, bounces = 256, 4
-    ref = cycles_of_import(gltf, tmp_path, spp, bounces)
+    ref = cycles_of_import(gltf, tmp_path, spp, bounces, world)
     assert ref[..., :3].mean() > 0.01, "the Cycles reference is black: the scene is broken"
-    got = run_tesela(tesela_bin, gltf, tmp_path / "tesela.exr", "path_mis", spp, bounces + 2)
+    extra = ["--background", *map(str, world)] if world else []
+    got = run_tesela(tesela_bin, gltf, tmp_path / "tesela.exr", "path_mis", spp, bounces + 2,
+                     extra=extra)
     result = imgcompare.compare(got, ref, mean_tol=0.02, block_tol=0.05)
     edge_err, grad_ratio = edge_agreement(got, ref)
     print(f"{name}: {result}; edges: blurred median err {edge_err:.4f}, "

@@ -285,7 +285,7 @@ impl<'a> Loader<'a> {
             Some(g) => Some(std::sync::Arc::new(self.material_graph(g, gi, &name)?)),
             None => None,
         };
-        Ok(Material {
+        let mut material = Material {
             name,
             base_color,
             base_color_texture,
@@ -315,7 +315,68 @@ impl<'a> Loader<'a> {
             graph,
             pass_index,
             unlit: extension(raw, "KHR_materials_unlit").is_some(),
-        })
+            glossiness_texture: None,
+        };
+        if let Some(e) = extension(raw, "KHR_materials_pbrSpecularGlossiness") {
+            self.specular_glossiness(e, gi, &mut material)?;
+        }
+        Ok(material)
+    }
+
+    /// `KHR_materials_pbrSpecularGlossiness` in place of the metallic-roughness factors, as
+    /// Blender's importer reads it into a Principled BSDF: base colour and alpha = diffuse
+    /// factor × texture; Specular Tint = specular factor × the RGB of the specular-glossiness
+    /// texture, with IOR 1000 (a Fresnel reflectance of 1 at normal incidence, so the tint is
+    /// the specular colour at every angle but grazing); roughness = 1 − glossiness factor ×
+    /// its alpha; not metallic.
+    fn specular_glossiness(
+        &mut self,
+        e: &Value,
+        gi: usize,
+        m: &mut Material,
+    ) -> Result<(), LoadError> {
+        const EXT: &str = "KHR_materials_pbrSpecularGlossiness";
+        let name = m.name.clone();
+        let diffuse = factors::<4>(e, "diffuseFactor", [1.0; 4]).unwrap_or_else(|()| {
+            self.warn_material(
+                gi,
+                &name,
+                format!("{EXT} `diffuseFactor` is malformed; using white"),
+            );
+            [1.0; 4]
+        });
+        m.base_color = Vec3::new(diffuse[0], diffuse[1], diffuse[2]).clamp(Vec3::ZERO, Vec3::ONE);
+        m.alpha = diffuse[3].clamp(0.0, 1.0);
+        m.base_color_texture = self.tex_info(
+            member(e, "diffuseTexture"),
+            gi,
+            &name,
+            &format!("{EXT}.diffuseTexture"),
+        )?;
+        let specular = factors::<3>(e, "specularFactor", [1.0; 3]).unwrap_or_else(|()| {
+            self.warn_material(
+                gi,
+                &name,
+                format!("{EXT} `specularFactor` is malformed; using white"),
+            );
+            [1.0; 3]
+        });
+        let glossiness = self.mat_factor(gi, &name, e, EXT, "glossinessFactor", 1.0, 0.0, 1.0);
+        let texture = self.tex_info(
+            member(e, "specularGlossinessTexture"),
+            gi,
+            &name,
+            &format!("{EXT}.specularGlossinessTexture"),
+        )?;
+        m.metallic = 0.0;
+        m.metallic_roughness_texture = None;
+        m.roughness = 1.0 - glossiness;
+        m.glossiness_texture = texture.filter(|_| glossiness > 0.0);
+        m.specular = 1.0;
+        m.specular_color = Vec3::from_array(specular).max(Vec3::ZERO);
+        m.specular_color_texture = texture;
+        m.ior = 1000.0;
+        Ok(())
     }
 
     /// `occlusionTexture` is read and checked but not rendered: a path tracer computes the

@@ -124,6 +124,7 @@ pub(crate) fn texture_slots(m: &Material) -> Vec<(&'static str, TexRef)> {
     add("transmissionTexture", &m.transmission_texture);
     add("specularTexture", &m.specular_texture);
     add("specularColorTexture", &m.specular_color_texture);
+    add("specularGlossinessTexture", &m.glossiness_texture);
     if let Some(c) = &m.clearcoat {
         add("clearcoatTexture", &c.texture);
         add("clearcoatRoughnessTexture", &c.roughness_texture);
