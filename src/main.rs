@@ -963,6 +963,12 @@ fn run_render(args: &RenderArgs) -> ExitCode {
             "tesela: warning: the scene has no triangles: the image shows only the background"
         );
     }
+    if rscene.emitters.is_empty() && rscene.triangle_count() > 0 {
+        // Files made for real-time viewers often carry no light: their viewers add one.
+        eprintln!(
+            "tesela: warning: the scene has no light (no lights, emissive surfaces or world): it renders black; --background R G B or --env FILE gives it a world"
+        );
+    }
     let build_s = build.elapsed().as_secs_f64();
     let bar = if args.quiet {
         indicatif::ProgressBar::hidden()

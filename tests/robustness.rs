@@ -589,6 +589,41 @@ fn a_scene_without_triangles_renders_the_background_with_a_warning() {
     }
 }
 
+#[test]
+fn a_scene_without_light_says_so() {
+    // Files made for real-time viewers often carry no light; the image is black, which is
+    // right, but the user is told why and what gives the scene a world.
+    let dir = scratch("unlit-scene");
+    let mut dark = triangle_doc(&TRI);
+    let o = dark.as_object_mut().unwrap();
+    o.remove("extensions");
+    o.remove("extensionsUsed");
+    for (name, doc, args, warns) in [
+        ("dark.gltf", dark.clone(), &[][..], true),
+        (
+            "dark.gltf",
+            dark,
+            &["--background", "1", "1", "1"][..],
+            false,
+        ),
+        ("world.gltf", triangle_doc(&TRI), &[][..], false),
+    ] {
+        let f = write(&dir, name, &to_bytes(&doc));
+        let out = dir.join("out.exr");
+        let mut cmd = vec!["render", &f, "-o", s(&out), "--width", "4", "--height", "4"];
+        cmd.extend_from_slice(&["--spp", "1"]);
+        cmd.extend_from_slice(args);
+        let o = run(&cmd, DEADLINE);
+        assert_eq!(o.code, 0, "{name}: {}", o.stderr);
+        assert_eq!(
+            o.stderr.contains("warning: the scene has no light"),
+            warns,
+            "{name} {args:?}: {}",
+            o.stderr
+        );
+    }
+}
+
 /// RGBA pixels of an EXR written by the renderer.
 fn read_exr(path: &Path) -> Vec<[f32; 4]> {
     use exr::prelude::*;
