@@ -728,15 +728,34 @@ fn clearcoat_sheen_anisotropy_and_volume_reach_the_principled_inputs() {
         4,
         "tangents for the coat normal map"
     );
-    let (p, _, tangent) = principled(&shade(&s, 0));
+    // A sheen over a coat is a closure of its own, as Cycles sets it up: one Principled
+    // closure carries the coat and the rest, another the sheen.
+    let set = shade(&s, 0);
+    let layers: Vec<_> = set
+        .closures()
+        .iter()
+        .filter_map(|c| match c.kind {
+            ClosureKind::Principled(p) => Some((p, c.tangent)),
+            _ => None,
+        })
+        .collect();
+    let (p, tangent) = *layers
+        .iter()
+        .find(|(p, _)| p.coat_weight > 0.0)
+        .expect("a coated closure");
     // Coat weight = 0.8 × R (1.0); roughness 0.4; IOR 1.5.
     assert!((p.coat_weight - 0.8).abs() < 1e-6, "{}", p.coat_weight);
     assert!((p.coat_roughness - 0.4).abs() < 1e-6);
     assert_eq!(p.coat_ior, 1.5);
     assert!(p.coat_normal.length() > 0.99, "coat normal map linked");
-    assert_eq!(p.sheen_weight, 1.0);
-    assert_eq!(p.sheen_tint, Vec3::new(1.0, 0.5, 0.25));
-    assert!((p.sheen_roughness - 0.3).abs() < 1e-6);
+    let (sheen, _) = layers
+        .iter()
+        .find(|(p, _)| p.sheen_weight > 0.0)
+        .expect("a sheen closure");
+    // Its weight is the glTF sheen's (1) over the sheen's albedo for the view direction.
+    assert!(sheen.sheen_weight >= 1.0 && sheen.sheen_weight.is_finite());
+    assert_eq!(sheen.sheen_tint, Vec3::new(1.0, 0.5, 0.25));
+    assert!((sheen.sheen_roughness - 0.3).abs() < 1e-6);
     assert!((p.anisotropic - 0.6).abs() < 1e-6);
     // Rotated 90° counter-clockwise from the tangent (+X): the bitangent, +Y.
     assert!(tangent.abs_diff_eq(Vec3::Y, 1e-5), "{tangent}");
