@@ -268,13 +268,38 @@ impl ShadingPoint {
             Some(rotation) => tangent_frame(n, tangent, rotation),
             None => Frame::from_normal(n),
         };
+        // A coat has its own normal, as in Cycles: the Coat Normal input, else the surface's
+        // (not the bumped one), raised to reflect above the surface; and a specular base below
+        // it is raised as a specular lobe of its own is.
+        let coat = coat_normal(bsdf, &closure.kind).map(|c| {
+            let c = if c == Vec3::ZERO {
+                let ns = if closure.surface_normal == Vec3::ZERO {
+                    its.ns
+                } else {
+                    closure.surface_normal
+                };
+                if ns.dot(-d) < 0.0 { -ns } else { ns }
+            } else {
+                c
+            };
+            bsdf::closure::valid_specular_normal(ng_seen, -d, c)
+        });
+        // A sheen keeps the bumped normal itself (Cycles does not raise it) over a raised base.
+        let sheen = (raise && sheen_on_top(bsdf) && specular_base(bsdf)).then_some(n);
+        if (coat.is_some() || sheen.is_some()) && raise && specular_base(bsdf) {
+            n = bsdf::closure::valid_specular_normal(ng_seen, -d, n);
+        }
+        let coat = coat.or(sheen);
         let frame = frame_of(n);
-        let glossy_frame = (raise && specular_over_diffuse(bsdf))
-            .then(|| {
-                let m = bsdf::closure::valid_specular_normal(ng_seen, -d, n);
-                (m != n).then(|| frame_of(m))
-            })
-            .flatten();
+        let glossy_frame = match coat {
+            Some(c) => (c != n).then(|| Frame::from_normal(c)),
+            None => (raise && specular_over_diffuse(bsdf))
+                .then(|| {
+                    let m = bsdf::closure::valid_specular_normal(ng_seen, -d, n);
+                    (m != n).then(|| frame_of(m))
+                })
+                .flatten(),
+        };
         let smooth = raise.then(|| {
             if turned_away {
                 return n;
@@ -467,7 +492,8 @@ impl ShadingPoint {
         let att = l.attenuation_at(wi_g);
         let (fb, pb) = l.base.eval_and_pdf(&BsdfQueryRecord::pair(self.wi, lo));
         let (ft, pt) = l.top.eval_and_pdf(&BsdfQueryRecord::pair(wi_g, wo_g));
-        let base = att * fb * lo.z.abs() * Self::bump_term(self.frame.n, ns, wo, is_eval, true);
+        let diffuse = !specular_base(&self.bsdf);
+        let base = att * fb * lo.z.abs() * Self::bump_term(self.frame.n, ns, wo, is_eval, diffuse);
         let top = ft * wo_g.z.abs() * Self::bump_term(g.n, ns, wo, is_eval, false);
         let p = l.top_probability(wi_g);
         (base + top, p * pt + (1.0 - p) * pb)
@@ -503,7 +529,9 @@ impl ShadingPoint {
     }
 
     /// Samples the two-frame pair: the world direction and its record, local to `self.frame`
-    /// (its density comes with the value, from [`Self::two_frame_eval_cos_pdf`]).
+    /// (its density comes with the value, from [`Self::two_frame_eval_cos_pdf`]); and for a
+    /// delta lobe (a smooth coat or mirror metal), which has no value to evaluate, its
+    /// weight, divided by the probability of choosing it.
     #[inline]
     fn two_frame_sample(
         &self,
@@ -511,7 +539,7 @@ impl ShadingPoint {
         d: Vec3,
         u: glam::Vec2,
         u1: f32,
-    ) -> Option<(Vec3, BsdfQueryRecord)> {
+    ) -> Option<(Vec3, BsdfQueryRecord, Option<Vec3>)> {
         let BsdfInstance::Layered(l) = &self.bsdf else {
             return None;
         };
@@ -531,10 +559,18 @@ impl ShadingPoint {
         if w == Vec3::ZERO && !bsdf::layered::sampled_direction(&rec) {
             return None;
         }
+        let discrete = (rec.measure == bsdf::Measure::Discrete).then(|| {
+            let p = l.top_probability(wi_g);
+            if top {
+                w / p
+            } else {
+                l.attenuation_at(wi_g) * w / (1.0 - p)
+            }
+        });
         let wo = frame.to_world(rec.wo);
         rec.wo = self.frame.to_local(wo);
         rec.wi = self.wi;
-        Some((wo, rec))
+        Some((wo, rec, discrete))
     }
 
     /// The chosen BSDF is one of Cycles' diffuse closures (`CLOSURE_IS_BSDF_DIFFUSE`).
@@ -651,7 +687,15 @@ impl ShadingPoint {
         // sample jointly with the pixel filter's offset too.
         let (u, u1) = ctx.sampler.reserved_3d();
         if let Some(g) = &self.glossy_frame {
-            let (wo, mut rec) = self.two_frame_sample(g, d, u, u1)?;
+            let (wo, mut rec, discrete) = self.two_frame_sample(g, d, u, u1)?;
+            if let Some(w) = discrete {
+                ctx.ray_flags = self.ray_flags(&rec, true, false);
+                if its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
+                    return None;
+                }
+                let w = w * self.weight;
+                return (w != Vec3::ZERO && w.is_finite()).then_some((wo, w, rec));
+            }
             let (f, pdf) = self.two_frame_eval_cos_pdf(g, d, wo, false);
             if !(pdf > 0.0 && pdf.is_finite()) {
                 return None;
@@ -714,6 +758,44 @@ fn raises_specular_normal(bsdf: &BsdfInstance) -> bool {
             | BsdfInstance::RoughConductor(_)
             | BsdfInstance::Dielectric(_)
             | BsdfInstance::RoughDielectric(_)
+    )
+}
+
+/// The normal of a coat on top of `bsdf`, made from closure `kind`: its Coat Normal (zero
+/// when unlinked: the surface normal); `None` without a coat on top.
+#[inline]
+fn coat_normal(bsdf: &BsdfInstance, kind: &crate::shading::ClosureKind) -> Option<Vec3> {
+    match (bsdf, kind) {
+        (BsdfInstance::Layered(l), crate::shading::ClosureKind::Principled(p))
+            if matches!(l.top, bsdf::layered::TopLobe::Coat(_)) =>
+        {
+            Some(p.coat_normal)
+        }
+        _ => None,
+    }
+}
+
+/// A sheen on top of a layered BSDF.
+#[inline]
+fn sheen_on_top(bsdf: &BsdfInstance) -> bool {
+    matches!(bsdf, BsdfInstance::Layered(l) if matches!(l.top, bsdf::layered::TopLobe::Sheen(_)))
+}
+
+/// A layered BSDF whose base is a specular lobe (metal, glass): Cycles raises its normal and
+/// corrects it for bumps as a glossy closure, not a diffuse one.
+#[inline]
+fn specular_base(bsdf: &BsdfInstance) -> bool {
+    use bsdf::layered::BaseLobe;
+    matches!(
+        bsdf,
+        BsdfInstance::Layered(l) if matches!(
+            l.base,
+            BaseLobe::Mirror(_)
+                | BaseLobe::RoughConductor(_)
+                | BaseLobe::Dielectric(_)
+                | BaseLobe::RoughDielectric(_)
+                | BaseLobe::CoatedConductor(_)
+        )
     )
 }
 

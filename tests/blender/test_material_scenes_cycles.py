@@ -820,6 +820,40 @@ def principled_variant(kind):
     return build
 
 
+def coated_normal_map(kind):
+    """A coat over a normal-mapped base, whose layers Cycles gives normals of their own: the
+    coat the Coat Normal input, else the surface's (unbumped) normal; the metal or specular
+    base the bumped normal raised to reflect above the surface; a sheen the bumped one.
+    ``flakes``: car paint, a red metal with a Voronoi cell normal per flake under a smooth
+    coat; ``tilted``: one strongly tilted normal over the whole ball (the coat keeps the
+    ball's); ``tilted_coat_normal``: the same normal linked to Coat Normal too;
+    ``flakes_sheen``: the flakes under a sheen instead."""
+    def build():
+        mat, nt, out = node_material("Coated_" + kind)
+        ins = dict(Base_Color=(0.5, 0.02, 0.02, 1.0), Metallic=1.0, Roughness=0.35,
+                   Coat_Weight=1.0, Coat_Roughness=0.03)
+        if kind.startswith("flakes"):
+            vor = node(nt, "ShaderNodeTexVoronoi", Scale=60.0)
+            nm = node(nt, "ShaderNodeNormalMap", Strength=0.4, Color=vor.outputs["Color"])
+        else:
+            nm = node(nt, "ShaderNodeNormalMap", Color=(0.85, 0.5, 0.8, 1.0))
+            ins.update(Base_Color=(0.9, 0.8, 0.6, 1.0), Roughness=0.25)
+        if kind == "flakes_sheen":
+            ins.update(Coat_Weight=0.0, Sheen_Weight=1.0, Sheen_Roughness=0.3)
+        p = principled(nt, out, **ins)
+        nt.links.new(nm.outputs["Normal"], p.inputs["Normal"])
+        if kind == "tilted_coat_normal":
+            nt.links.new(nm.outputs["Normal"], p.inputs["Coat Normal"])
+        _sphere_stage(mat)
+        # A ball as Blender makes one, with its UV map (tangent-space normal maps need one).
+        bpy.data.objects.remove(bpy.data.objects["Ball"])
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.6, location=(0.0, 0.0, 0.6),
+                                             segments=64, ring_count=32)
+        bpy.ops.object.shade_smooth()
+        bpy.context.active_object.data.materials.append(mat)
+    return build
+
+
 def metallic_bsdf(fresnel):
     """Blender 4.3+'s Metallic BSDF on the ball: F82 (base colour and edge tint, anisotropic
     along the sphere's radial tangent) or a physical conductor (Blender's default gold IOR and
@@ -1215,6 +1249,9 @@ CASES = [
     ("emission_light_falloff", emission_light_falloff, 2, 256, 1024),
     ("emitter_hidden_from_camera", emitter_hidden_from_camera, 2, 256, 1024),
     ("principled_coat", principled_variant("coat"), 0, 256, 1024),
+    ("coat_over_normal_mapped_flakes", coated_normal_map("flakes"), 0, 256, 1024),
+    ("coat_over_tilted_normal", coated_normal_map("tilted"), 0, 256, 1024),
+    ("coat_normal_linked_tilted", coated_normal_map("tilted_coat_normal"), 0, 256, 1024),
     ("principled_sheen", principled_variant("sheen"), 0, 256, 1024),
     ("principled_sheen_over_coat", principled_variant("sheen_over_coat"), 0, 256, 1024),
     ("principled_emission_under_coat_and_sheen", principled_variant("emission_coat_sheen"),
