@@ -113,11 +113,6 @@ def convert_light(light, obj, matrix=None, warnings=None, images=None):
         ext["spot_blend"] = finite(light.spot_blend)
         if getattr(light, "use_square", False) and warnings is not None:
             warnings.append("light '%s': square spots render as round ones" % obj.name)
-        if matrix is not None and warnings is not None:
-            sx, sy = (float(np.linalg.norm(matrix[:3, k])) for k in (0, 1))
-            if abs(sx - sy) > 1e-4 * max(sx, sy):
-                warnings.append("light '%s': a spot scaled unevenly across its axis (an "
-                                "elliptic cone in Cycles) renders as a round cone" % obj.name)
     if t == "AREA":
         ext["shape"] = light.shape
         ext["size"] = finite(light.size)

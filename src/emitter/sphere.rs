@@ -13,7 +13,7 @@
 //!
 //! A spot's falloff is evaluated on the direction the light travels from the sampled point.
 
-use super::spot::{spot_cos_outer, spot_falloff};
+use super::spot::{spot_attenuation, spot_cos_outer};
 use super::{Emitter, EmitterQueryRecord, emitted_luminance};
 use crate::frame::Frame;
 use crate::sampling::{square_to_uniform_disk, square_to_uniform_sphere};
@@ -97,7 +97,7 @@ impl SphereLight {
     #[inline]
     fn attenuation(&self, w: Vec3) -> f32 {
         match &self.spot {
-            Some((axis, f)) => spot_falloff(f, axis.dot(w)),
+            Some((axis, f)) => spot_attenuation(f, *axis, w),
             None => 1.0,
         }
     }

@@ -191,7 +191,8 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), String> {
                         cos_inner,
                         cos_outer,
                     } => (cos_inner.acos(), cos_outer.acos()),
-                    SpotFalloff::Cycles { cos_half, .. } => (0.0, cos_half.acos()),
+                    SpotFalloff::Cycles { cos_half, .. }
+                    | SpotFalloff::CyclesScaled { cos_half, .. } => (0.0, cos_half.acos()),
                 };
                 (
                     json!({"translation": position.to_array(), "rotation": rotation_to(direction)}),

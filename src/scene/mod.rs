@@ -498,6 +498,15 @@ pub enum SpotFalloff {
     /// Cycles: `smoothstep(0, 1, (cos θ - cos_half) / smooth)` with
     /// `smooth = (1 - cos_half) * blend`; a hard edge when `smooth` is 0.
     Cycles { cos_half: f32, smooth: f32 },
+    /// Cycles' falloff for a spot whose object is scaled unevenly: `cos θ` is taken of the
+    /// direction in the light's own unscaled space, `normalize(local · w)`'s z for a world
+    /// direction `w` leaving the light (rows of `local`: the light's x, y axes and its beam
+    /// axis, each over its scale), so the cone is elliptic or wider or narrower than its size.
+    CyclesScaled {
+        cos_half: f32,
+        smooth: f32,
+        local: glam::Mat3,
+    },
 }
 
 /// Lights other than emissive meshes (those are found from their materials).

@@ -84,6 +84,19 @@ def spot_radius_soft():
     return info
 
 
+def spot_scaled(scale, radius=0.0):
+    """A spot whose object is scaled: Cycles takes the cone's angle in the light's unscaled
+    space, so an uneven scale across the beam makes the cone elliptic, and a scale along the
+    beam narrows or widens it."""
+    def build():
+        info = _plane_with_box()
+        ob = scenes.add_spot_light("Spot", (0.2, -0.4, 2.2), (-0.3, 0.3, 0.0), 200.0,
+                                   math.radians(50.0), blend=0.2, radius=radius)
+        ob.scale = scale
+        return info
+    return build
+
+
 def light_nodes():
     """Lights with node trees: a spot whose Emission is coloured and scaled, and a point light
     whose strength comes through Light Falloff's Quadratic output."""
@@ -261,6 +274,8 @@ CASES = [
     ("point_radius_sphere", point_radius(False), 0, "direct_mis", 512),
     ("spot_radius_blend_sphere", spot_radius_blend, 0, "direct_mis", 512),
     ("spot_radius_soft", spot_radius_soft, 0, "direct_mis", 512),
+    ("spot_scaled_elliptic", spot_scaled((2.0, 0.7, 1.0)), 0, "direct_mis", 256),
+    ("spot_scaled_along_beam", spot_scaled((1.5, 1.5, 0.8), radius=0.1), 0, "direct_mis", 512),
     ("sun_angle", sun_angle, 0, "direct_mis", 512),
     ("light_node_trees", light_nodes, 0, "direct_mis", 512),
     ("light_node_trees_evaluated", light_nodes_evaluated, 0, "direct_mis", 512),

@@ -209,7 +209,7 @@ impl<'a> Loader<'a> {
                     }
                     let cos_half = (0.5 * size.clamp(0.0, PI)).cos();
                     let smooth = (1.0 - cos_half) * blend.clamp(0.0, 1.0);
-                    Some((direction, SpotFalloff::Cycles { cos_half, smooth }))
+                    Some((direction, spot_cone(world, cos_half, smooth)))
                 } else {
                     None
                 };
@@ -314,5 +314,29 @@ impl<'a> Loader<'a> {
         };
         self.scene.lights.push(Light::Blender { shape, visibility });
         Ok(())
+    }
+}
+
+/// Cycles' spot falloff for a light whose node transform is `world`: scaled by the same
+/// amount along its three axes (or not at all), the plain cone about its axis; else the cone
+/// the scale stretches (Cycles takes the angle in the light's unscaled space).
+fn spot_cone(world: Mat4, cos_half: f32, smooth: f32) -> SpotFalloff {
+    let m = glam::Mat3::from_mat4(world);
+    let s = Vec3::new(m.x_axis.length(), m.y_axis.length(), m.z_axis.length());
+    let uniform = s.max_element() - s.min_element() <= 1e-4 * s.max_element();
+    if uniform || s.min_element() <= 0.0 || !s.is_finite() {
+        return SpotFalloff::Cycles { cos_half, smooth };
+    }
+    // Rows: the light's x and y axes and its beam axis (-z), each divided by its scale.
+    let local = glam::Mat3::from_cols(
+        m.x_axis / (s.x * s.x),
+        m.y_axis / (s.y * s.y),
+        -m.z_axis / (s.z * s.z),
+    )
+    .transpose();
+    SpotFalloff::CyclesScaled {
+        cos_half,
+        smooth,
+        local,
     }
 }
