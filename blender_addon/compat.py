@@ -213,6 +213,40 @@ def normals(mesh, n_loops):
     return "CORNER", corner_normals(mesh, n_loops)
 
 
+def cycles_normals(mesh, n_loops, n_polys):
+    """The normals as Cycles shades them: (domain, float32 array, flat) like normals() plus
+    flat, a bool per face (None: none) for the faces Cycles shades with each triangle's own
+    geometric normal. Cycles (4.1+) asks Blender for the normal domain allowing sharp faces:
+    with every face flat (or every edge sharp), every triangle is flat; without custom normals
+    or sharp edges, the flat faces are flat triangles and the smooth ones take the vertex
+    normals, which average every face around the vertex, the flat ones too (the corner normals
+    Blender computes instead stop at flat faces). Only with sharp edges or custom normals does
+    it shade with the corner normals (a flat face's then is its polygon's normal)."""
+    domain, values = normals(mesh, n_loops)
+    if not hasattr(mesh, "normals_domain"):  # before 4.1: as Blender gives them
+        return domain, values, None
+    if domain == "FACE":
+        return domain, values, np.ones(n_polys, dtype=bool)
+    if domain != "CORNER" or getattr(mesh, "has_custom_normals", False) or _any_sharp_edge(mesh):
+        return domain, values, None
+    smooth = np.empty(n_polys, dtype=bool)
+    mesh.polygons.foreach_get("use_smooth", smooth)
+    return "POINT", vertex_normals(mesh, len(mesh.vertices)), ~smooth
+
+
+def _any_sharp_edge(mesh):
+    """Whether any edge of the mesh is marked sharp."""
+    attributes = getattr(mesh, "attributes", None)
+    a = attributes.get("sharp_edge") if attributes is not None else None
+    if a is not None and a.domain == "EDGE" and a.data_type == "BOOLEAN":
+        values = np.empty(len(a.data), dtype=bool)
+        a.data.foreach_get("value", values)
+        return bool(values.any())
+    values = np.empty(len(mesh.edges), dtype=bool)
+    mesh.edges.foreach_get("use_edge_sharp", values)
+    return bool(values.any())
+
+
 def vertex_normals(mesh, n_verts):
     """Blender's vertex normals, float32 (n_verts, 3) (4.1 moved them off the vertices)."""
     out = np.empty(n_verts * 3, dtype=np.float32)

@@ -65,6 +65,8 @@ class RawMesh:
         self.co = None           # float32 (n_verts, 3)
         self.normal_domain = None  # "POINT", "FACE" or "CORNER": what `normals` has one of
         self.normals = None      # float32 (n, 3): vertex, face or corner normals (compat.normals)
+        self.flat = None         # bool (n_polys,): faces shaded with their triangles' own
+        #                          geometric normals, as Cycles does (compat.cycles_normals)
         self.uvs = []            # [(name, float32 (n_loops, 2))], the render map first
         self.colors = []         # [(name, float32 (n_loops or n_verts, 4), domain)]
         self.texspace = None     # (location, size)
@@ -80,7 +82,9 @@ class RawMesh:
         """blake2b of every array and of `context` (what else the export depends on, e.g. the
         UV maps the materials want tangents for), hex."""
         h = hashlib.blake2b(digest_size=20)
-        for a in (self.loop_vert, self.loop_start, self.face_material, self.co, self.normals):
+        flat = self.flat if self.flat is not None else np.zeros(0, dtype=bool)
+        for a in (self.loop_vert, self.loop_start, self.face_material, self.co, self.normals,
+                  flat):
             h.update(b"|%d|" % a.size)
             h.update(np.ascontiguousarray(a).reshape(-1).view(np.uint8))  # bytes, no copy
         for name, a, *domain in self.uvs + self.colors:
@@ -288,7 +292,7 @@ def read_mesh(mesh, check_cancel=None, phases=None):
         raw.co = compat.vertex_positions(mesh, n_verts)
     checkpoint()
     with phases("normals"):
-        raw.normal_domain, raw.normals = compat.normals(mesh, n_loops)
+        raw.normal_domain, raw.normals, raw.flat = compat.cycles_normals(mesh, n_loops, n_polys)
     checkpoint()
     with phases("uvs"):
         for layer in compat.uv_layers(mesh):
@@ -440,8 +444,55 @@ def mesh_arrays(mesh, check_cancel=None, tangent_uvs=None, warn=None, label="", 
             out.tangents = _tangent_vec4(per_corner(tangents[0]), per_corner(tangents[1]),
                                          out.normals)
 
+    if raw.flat is not None:
+        with phases("flat triangles"):
+            flat_tri = np.take(raw.flat, tri_face)
+            if flat_tri.any():
+                _flat_shade(out, flat_tri)
     out.texspace = raw.texspace
     return out
+
+
+# Flat triangles share a glTF vertex where their normals agree to this many steps per unit
+# (the two halves of a planar quad, whose computed normals differ in the last bits).
+FLAT_NORMAL_STEPS = 1 << 16
+
+
+def _flat_shade(out, flat_tri):
+    """Gives the triangles flagged in flat_tri (bool per triangle) their own geometric normal,
+    as Cycles shades a flat face: a non-planar face (a twisted quad, an n-gon) then shows its
+    triangles, not the polygon's one normal. A glTF vertex is shared by the corners of
+    triangles whose normals agree (and by the smooth triangles' corners, which keep theirs);
+    degenerate triangles keep the normals they had."""
+    tri = out.indices.astype(np.int64)
+    p = out.positions.astype(np.float64)
+    flat = np.flatnonzero(flat_tri)
+    a = _take(p, tri[flat, 0])
+    n = np.cross(_take(p, tri[flat, 1]) - a, _take(p, tri[flat, 2]) - a)
+    length = np.linalg.norm(n, axis=1)
+    ok = length > 1e-30
+    flat, n = flat[ok], n[ok] / length[ok, None]
+    # A key per triangle corner: its vertex, then its triangle's normal in steps (a flat one) or
+    # a value no normal takes (a smooth or degenerate one: the vertex's own normal).
+    keys = np.full((tri.shape[0], 3, 4), 4 * FLAT_NORMAL_STEPS, dtype=np.int64)
+    keys[:, :, 0] = tri
+    keys[flat, :, 1:] = np.rint(n * FLAT_NORMAL_STEPS).astype(np.int64)[:, None, :]
+    keys = keys.reshape(-1, 4)
+    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    src = keys[first, 0]
+    normals = np.repeat(n.astype(np.float32), 3, axis=0)  # per flat triangle corner
+    corner_normal = np.full(tri.shape[0] * 3, -1, dtype=np.int64)
+    corner_normal[(flat[:, None] * 3 + np.arange(3)).reshape(-1)] = np.arange(normals.shape[0])
+    which = corner_normal[first]
+    out.normals = _take(out.normals, src)
+    mine = which >= 0
+    out.normals[mine] = normals[which[mine]]
+    out.positions = _take(out.positions, src)
+    out.uv_sets = [(name, _take(uv, src)) for name, uv in out.uv_sets]
+    out.color_sets = [(name, _take(col, src)) for name, col in out.color_sets]
+    if out.tangents is not None:
+        out.tangents = _take(out.tangents, src)
+    out.indices = inverse.reshape(-1, 3).astype(np.uint32)
 
 
 def _finite(a):

@@ -1,9 +1,9 @@
 """The mesh writer (blender_addon/export/mesh.py) against a reference built the plain way: every
 attribute read per corner through the item-by-item Blender API (one glTF vertex per corner, as
 the writer once did). Whatever the writer shares between corners, each triangle corner must
-read bitwise what the reference gives it: positions, normals (smooth, flat, sharp edges,
-custom), UV maps, colour attributes (corner and point), MikkTSpace and n-gon tangents,
-material indices.
+read bitwise what the reference gives it: positions, normals (smooth, sharp edges, custom; flat
+triangles: their own normal, as Cycles shades them, within a small step), UV maps, colour
+attributes (corner and point), MikkTSpace and n-gon tangents, material indices.
 """
 
 import math
@@ -73,8 +73,22 @@ def _reference(mesh, tangent_uv=None):
     mesh.vertices.foreach_get("co", co)
     nrm = np.empty(nl * 3, dtype=np.float32)
     mesh.corner_normals.foreach_get("vector", nrm)
+    nrm = nrm.reshape(-1, 3)
+    # Cycles' normals: Blender's corner normals with sharp edges or custom normals; else the
+    # smooth faces take the vertex normals and the flat ones each triangle's own normal.
+    loop_face_of_tri = np.empty(nt, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("polygon_index", loop_face_of_tri)
+    smooth = np.array([f.use_smooth for f in mesh.polygons])
+    sharp_edges = any(e.use_edge_sharp for e in mesh.edges)
+    flat = np.zeros(nt, dtype=bool)
+    if mesh.normals_domain == "FACE":
+        flat[:] = True
+    elif not (mesh.has_custom_normals or sharp_edges):
+        vn = np.array([tuple(v.normal) for v in mesh.vertices], dtype=np.float32)
+        nrm = vn[lv]
+        flat = ~smooth[loop_face_of_tri]
     ref = {"tri": tri.reshape(-1, 3), "mat": mat, "POSITION": co.reshape(-1, 3)[lv],
-           "NORMAL": nrm.reshape(-1, 3)}
+           "NORMAL": nrm, "flat": flat}
     for i, layer in enumerate(compat.uv_layers(mesh)):
         uv = np.empty(nl * 2, dtype=np.float32)
         layer.data.foreach_get("uv", uv)
@@ -116,12 +130,21 @@ def _assert_same_corners(mesh, tangent_uvs=None, tangent_uv=None):
     ref = _reference(mesh, tangent_uv)
     assert np.array_equal(data.tri_material, ref["mat"])
     written = _written(data)
-    assert set(written) == set(ref) - {"tri", "mat"}
+    assert set(written) == set(ref) - {"tri", "mat", "flat"}
     idx = data.indices.astype(np.int64)
     assert idx.shape == ref["tri"].shape and idx.max() < data.positions.shape[0]
+    flat = ref["flat"]
     for name, values in written.items():
         assert values.dtype == np.float32 and values.flags.c_contiguous, name
         got, want = values[idx], ref[name][ref["tri"]]
+        if name == "NORMAL":
+            # Flat triangles: their own geometric normal (within the step that lets the two
+            # halves of a planar quad share vertices).
+            p = ref["POSITION"][ref["tri"][flat]].astype(np.float64)
+            ng = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+            ng /= np.linalg.norm(ng, axis=1, keepdims=True)
+            assert not flat.any() or np.abs(got[flat] - ng[:, None, :]).max() < 1e-4, name
+            got, want = got[~flat], want[~flat]
         assert np.array_equal(got.view(np.uint32), want.view(np.uint32)), name
     return data
 
@@ -205,6 +228,23 @@ def test_flat_shading(clean):
     me = _sphere("Facets", smooth=False)
     assert compat.normals(me, len(me.loops))[0] == "FACE"
     _assert_same_corners(me)
+
+
+def test_flat_faces_of_a_smooth_mesh_and_non_planar_faces(clean):
+    """Flat faces among smooth ones without sharp edges (Cycles: the smooth faces take the
+    vertex normals, the flat ones each triangle's normal), and non-planar flat quads."""
+    me = _sphere("Mixed")
+    me.polygons.foreach_set("use_smooth", np.arange(len(me.polygons)) % 5 != 0)
+    me.update()
+    assert compat.normals(me, len(me.loops))[0] == "CORNER"
+    assert compat.cycles_normals(me, len(me.loops), len(me.polygons))[0] == "POINT"
+    _assert_same_corners(me)
+    bumpy = _grid("Bumpy")  # sin-displaced grid: no quad is planar
+    bumpy.polygons.foreach_set("use_smooth", np.zeros(len(bumpy.polygons), dtype=bool))
+    bumpy.update()
+    data = _assert_same_corners(bumpy)
+    # Each quad's two triangles have normals of their own: more vertices than corners.
+    assert data.positions.shape[0] == 2 * 3 * len(bumpy.polygons)
 
 
 def test_sharp_edges_and_custom_normals(clean):

@@ -587,6 +587,33 @@ def lowpoly_smooth_specular():
     scenes.add_camera((0.0, -3.0, 1.0), (0.0, 0.0, 0.5), fov=math.radians(45.0))
 
 
+def flat_and_mixed_shading():
+    """How Cycles shades flat faces: a flat-shaded cube twisted by a Simple Deform modifier (its
+    side quads are not planar: each shows its two triangles, each with its own normal), and a
+    12-sided cylinder with smooth sides and flat caps, no sharp edge (its sides take the vertex
+    normals, which average the caps in: the rims look rounded, as in Cycles but not in the
+    viewport); beside it the same cylinder with one edge marked sharp, which Cycles shades with
+    Blender's corner normals (the sides' normals stop at the caps)."""
+    scenes.add_quad("Floor", [(-4, -4, 0), (4, -4, 0), (4, 4, 0), (-4, 4, 0)],
+                    lambert_mat("Floor", (0.5, 0.5, 0.5)))
+    bpy.ops.mesh.primitive_cube_add(size=0.7, location=(-0.9, 0.2, 0.4))
+    cube = bpy.context.active_object
+    cube.data.materials.append(scenes.material("Twist", (0.7, 0.7, 0.2), roughness=0.3))
+    twist = cube.modifiers.new("Twist", "SIMPLE_DEFORM")
+    twist.deform_method, twist.angle = "TWIST", 1.2
+    for x, sharp in ((0.1, False), (1.0, True)):
+        bpy.ops.mesh.primitive_cylinder_add(vertices=12, radius=0.4, depth=0.8,
+                                            location=(x, 0.0, 0.4))
+        cyl = bpy.context.active_object
+        cyl.data.materials.append(scenes.material("Cyl", (0.8, 0.4, 0.2), roughness=0.35))
+        for face in cyl.data.polygons:
+            face.use_smooth = abs(face.normal.z) < 0.5
+        cyl.data.edges[0].use_edge_sharp = sharp
+    scenes.add_sun_light("Sun", (0.4, 0.6, -0.8), 3.0, angle=math.radians(3.0))
+    world(0.6, (0.4, 0.45, 0.5))
+    scenes.add_camera((0.0, -3.2, 2.0), (0.0, 0.0, 0.4), fov=math.radians(45.0))
+
+
 def mix_layer_weight():
     """Mix Shader of Diffuse (fac 0) and Glossy (fac 1) by Layer Weight's Facing (blend 0.4)."""
     mat, nt, out = node_material("LayerMix")
@@ -1222,6 +1249,7 @@ CASES = [
     ("mapping_scale_rotation", mapping_image, 0, 64, 256),
     ("mix_diffuse_glossy_layer_weight", mix_layer_weight, 0, 256, 1024),
     ("lowpoly_smooth_specular", lowpoly_smooth_specular, 2, 256, 1024),
+    ("flat_and_mixed_shading", flat_and_mixed_shading, 2, 128, 512),
     ("oren_nayar_diffuse_ball", oren_nayar_ball("diffuse"), 2, 128, 512),
     ("oren_nayar_principled_ball", oren_nayar_ball("principled"), 2, 128, 512),
     ("principled_black_base", black_base_ball, 2, 128, 512),
