@@ -17,9 +17,11 @@ pub mod scaled;
 pub mod subsurface;
 
 use crate::accel::offset_origin;
+use crate::bsdf::layered::{BaseLobe, TopLobe};
 use crate::bsdf::{self, Bsdf, BsdfInstance, BsdfQueryRecord};
 use crate::frame::Frame;
 use crate::render_scene::{Ctx, Emitted, Intersection, RenderScene};
+use crate::sampling::pick;
 use glam::Vec3;
 
 /// One integrator: radiance along the unit-direction ray `o + t d`.
@@ -138,6 +140,9 @@ pub struct ShadingPoint {
     /// map makes its normal differ from the diffuse one (Cycles raises a specular closure's
     /// normal so that it reflects above the surface; the diffuse keeps the mapped one).
     glossy_frame: Option<Frame>,
+    /// Under a coat (in `glossy_frame`) over Principled's dielectric base, the frame of that
+    /// base's specular layer when its raised normal differs from the diffuse one's.
+    inner_frame: Option<Frame>,
 }
 
 impl ShadingPoint {
@@ -155,6 +160,7 @@ impl ShadingPoint {
             subsurface: None,
             smooth: None,
             glossy_frame: None,
+            inner_frame: None,
         }
     }
 
@@ -290,6 +296,14 @@ impl ShadingPoint {
             n = bsdf::closure::valid_specular_normal(ng_seen, -d, n);
         }
         let coat = coat.or(sheen);
+        // Under a coat, Principled's dielectric base keeps its two normals: the specular
+        // layer's raised, the diffuse's as mapped.
+        let inner_frame = (coat.is_some() && raise && specular_diffuse_base(bsdf))
+            .then(|| {
+                let m = bsdf::closure::valid_specular_normal(ng_seen, -d, n);
+                (m != n).then(|| Frame::from_normal(m))
+            })
+            .flatten();
         let frame = frame_of(n);
         let glossy_frame = match coat {
             Some(c) => (c != n).then(|| Frame::from_normal(c)),
@@ -318,6 +332,7 @@ impl ShadingPoint {
         }
         self.smooth = smooth;
         self.glossy_frame = glossy_frame;
+        self.inner_frame = inner_frame.filter(|_| glossy_frame.is_some());
         self.passes = matches!(
             closure.kind,
             crate::shading::ClosureKind::Transparent { .. }
@@ -369,6 +384,7 @@ impl ShadingPoint {
             subsurface: Some(s.bssrdf),
             smooth: None,
             glossy_frame: None,
+            inner_frame: None,
         }
     }
 
@@ -391,6 +407,7 @@ impl ShadingPoint {
             subsurface: None,
             smooth: None,
             glossy_frame: None,
+            inner_frame: None,
         }
     }
 
@@ -490,10 +507,29 @@ impl ShadingPoint {
         let ns = self.smooth.unwrap_or(self.frame.n);
         let (wi_g, wo_g, lo) = (g.to_local(-d), g.to_local(wo), self.frame.to_local(wo));
         let att = l.attenuation_at(wi_g);
-        let (fb, pb) = l.base.eval_and_pdf(&BsdfQueryRecord::pair(self.wi, lo));
         let (ft, pt) = l.top.eval_and_pdf(&BsdfQueryRecord::pair(wi_g, wo_g));
-        let diffuse = !specular_base(&self.bsdf);
-        let base = att * fb * lo.z.abs() * Self::bump_term(self.frame.n, ns, wo, is_eval, diffuse);
+        let (fb, pb) = match (&self.inner_frame, &l.base) {
+            (Some(m), BaseLobe::SpecularDiffuse(inner)) => {
+                // The base's specular layer in its own frame over its diffuse in `self.frame`.
+                let (wi_m, wo_m) = (m.to_local(-d), m.to_local(wo));
+                let (fs, ps) = inner.top.eval_and_pdf(&BsdfQueryRecord::pair(wi_m, wo_m));
+                let (fd, pd) = inner.base.eval_and_pdf(&BsdfQueryRecord::pair(self.wi, lo));
+                let q = inner.top_probability(wi_m);
+                let f = fs * wo_m.z.abs() * Self::bump_term(m.n, ns, wo, is_eval, false)
+                    + inner.attenuation_at(wi_m)
+                        * fd
+                        * lo.z.abs()
+                        * Self::bump_term(self.frame.n, ns, wo, is_eval, true);
+                (f, q * ps + (1.0 - q) * pd)
+            }
+            _ => {
+                let (fb, pb) = l.base.eval_and_pdf(&BsdfQueryRecord::pair(self.wi, lo));
+                let diffuse = !specular_base(&self.bsdf);
+                let bump = Self::bump_term(self.frame.n, ns, wo, is_eval, diffuse);
+                (fb * lo.z.abs() * bump, pb)
+            }
+        };
+        let base = att * fb;
         let top = ft * wo_g.z.abs() * Self::bump_term(g.n, ns, wo, is_eval, false);
         let p = l.top_probability(wi_g);
         (base + top, p * pt + (1.0 - p) * pb)
@@ -522,10 +558,17 @@ impl ShadingPoint {
         };
         let wi_g = g.to_local(-d);
         let p = l.top_probability(wi_g);
-        p * l.top.pdf(&BsdfQueryRecord::pair(wi_g, g.to_local(wo)))
-            + (1.0 - p)
-                * l.base
-                    .pdf(&BsdfQueryRecord::pair(self.wi, self.frame.to_local(wo)))
+        let lo = self.frame.to_local(wo);
+        let base = match (&self.inner_frame, &l.base) {
+            (Some(m), BaseLobe::SpecularDiffuse(inner)) => {
+                let wi_m = m.to_local(-d);
+                let q = inner.top_probability(wi_m);
+                q * inner.top.pdf(&BsdfQueryRecord::pair(wi_m, m.to_local(wo)))
+                    + (1.0 - q) * inner.base.pdf(&BsdfQueryRecord::pair(self.wi, lo))
+            }
+            _ => l.base.pdf(&BsdfQueryRecord::pair(self.wi, lo)),
+        };
+        p * l.top.pdf(&BsdfQueryRecord::pair(wi_g, g.to_local(wo))) + (1.0 - p) * base
     }
 
     /// Samples the two-frame pair: the world direction and its record, local to `self.frame`
@@ -539,21 +582,44 @@ impl ShadingPoint {
         d: Vec3,
         u: glam::Vec2,
         u1: f32,
-    ) -> Option<(Vec3, BsdfQueryRecord, Option<Vec3>)> {
+    ) -> Option<(Vec3, BsdfQueryRecord, Option<Vec3>, bool)> {
         let BsdfInstance::Layered(l) = &self.bsdf else {
             return None;
         };
         let wi_g = g.to_local(-d);
         let (top, u1) = l.pick(wi_g, u1);
-        let (frame, mut rec) = if top {
-            (g, BsdfQueryRecord::new(wi_g))
-        } else {
-            (&self.frame, BsdfQueryRecord::new(self.wi))
+        // Under the top: the base's specular layer in its own frame, or the base as a whole.
+        let inner = match (&self.inner_frame, &l.base) {
+            (Some(m), BaseLobe::SpecularDiffuse(inner)) if !top => Some((m, inner)),
+            _ => None,
         };
-        let w = if top {
-            l.top.sample(&mut rec, u, u1)
+        let (frame, mut rec, w, diffuse) = if top {
+            let mut rec = BsdfQueryRecord::new(wi_g);
+            let w = l.top.sample(&mut rec, u, u1);
+            (g, rec, w, matches!(l.top, TopLobe::Sheen(_)))
+        } else if let Some((m, inner)) = inner {
+            let wi_m = m.to_local(-d);
+            let q = inner.top_probability(wi_m);
+            let (spec, u1) = pick(q, u1);
+            if spec {
+                let mut rec = BsdfQueryRecord::new(wi_m);
+                let w = inner.top.sample(&mut rec, u, u1) / q;
+                (m, rec, w, false)
+            } else {
+                let mut rec = BsdfQueryRecord::new(self.wi);
+                let w = inner.attenuation_at(wi_m) * inner.base.sample(&mut rec, u, u1) / (1.0 - q);
+                (&self.frame, rec, w, true)
+            }
         } else {
-            l.base.sample(&mut rec, u, u1)
+            let mut rec = BsdfQueryRecord::new(self.wi);
+            let w = l.base.sample(&mut rec, u, u1);
+            let diffuse = match &l.base {
+                BaseLobe::Diffuse(_) | BaseLobe::Translucent(_) => true,
+                BaseLobe::CoatedDiffuse(b) => !b.pick(self.wi, u1).0,
+                BaseLobe::SpecularDiffuse(b) => !b.pick(self.wi, u1).0,
+                _ => false,
+            };
+            (&self.frame, rec, w, diffuse)
         };
         // The pair's weight comes from its value; a black lobe's direction still counts.
         if w == Vec3::ZERO && !bsdf::layered::sampled_direction(&rec) {
@@ -570,7 +636,7 @@ impl ShadingPoint {
         let wo = frame.to_world(rec.wo);
         rec.wo = self.frame.to_local(wo);
         rec.wi = self.wi;
-        Some((wo, rec, discrete))
+        Some((wo, rec, discrete, diffuse))
     }
 
     /// The chosen BSDF is one of Cycles' diffuse closures (`CLOSURE_IS_BSDF_DIFFUSE`).
@@ -687,9 +753,9 @@ impl ShadingPoint {
         // sample jointly with the pixel filter's offset too.
         let (u, u1) = ctx.sampler.reserved_3d();
         if let Some(g) = &self.glossy_frame {
-            let (wo, mut rec, discrete) = self.two_frame_sample(g, d, u, u1)?;
+            let (wo, mut rec, discrete, diffuse) = self.two_frame_sample(g, d, u, u1)?;
             if let Some(w) = discrete {
-                ctx.ray_flags = self.ray_flags(&rec, true, false);
+                ctx.ray_flags = self.ray_flags(&rec, true, diffuse);
                 if its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
                     return None;
                 }
@@ -701,7 +767,7 @@ impl ShadingPoint {
                 return None;
             }
             rec.pdf = pdf;
-            ctx.ray_flags = self.ray_flags(&rec, true, self.sampled_diffuse(g.to_local(-d), u1));
+            ctx.ray_flags = self.ray_flags(&rec, true, diffuse);
             if its.ng.dot(wo) * its.ng.dot(-d) <= 0.0 {
                 return None;
             }
@@ -773,6 +839,12 @@ fn coat_normal(bsdf: &BsdfInstance, kind: &crate::shading::ClosureKind) -> Optio
         }
         _ => None,
     }
+}
+
+/// A coat or sheen over Principled's dielectric base (a specular layer over diffuse).
+#[inline]
+fn specular_diffuse_base(bsdf: &BsdfInstance) -> bool {
+    matches!(bsdf, BsdfInstance::Layered(l) if matches!(l.base, bsdf::layered::BaseLobe::SpecularDiffuse(_)))
 }
 
 /// A sheen on top of a layered BSDF.
@@ -985,4 +1057,159 @@ pub fn trace_lit(
 #[inline]
 pub fn spawn(its: &Intersection, wo: Vec3) -> Vec3 {
     offset_origin(its.p, its.ng, wo)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shading::{Closure, ClosureKind, Principled};
+
+    /// A shading point of a coated Principled BSDF (dielectric or metal base) under a tilted
+    /// mapped normal seen at a grazing angle, with the frames `shade` gives it: the coat on the
+    /// surface normal, the base's specular layer on the raised normal, the diffuse on the
+    /// mapped one.
+    fn coated(metallic: f32, coat_roughness: f32) -> (ShadingPoint, Intersection, Vec3) {
+        let closure = Closure {
+            weight: Vec3::ONE,
+            normal: Vec3::ZERO,
+            tangent: Vec3::ZERO,
+            surface_normal: Vec3::ZERO,
+            kind: ClosureKind::Principled(Principled {
+                base_color: Vec3::new(0.8, 0.5, 0.3),
+                metallic,
+                roughness: 0.4,
+                specular_level: 0.5,
+                coat_weight: 1.0,
+                coat_roughness,
+                coat_ior: 1.5,
+                coat_tint: Vec3::ONE,
+                ..Principled::lobe_only()
+            }),
+        };
+        let mut bsdf = bsdf::from_closure(&closure, 0.5);
+        let ng = Vec3::Z;
+        let d = -Vec3::new(0.9, 0.0, 0.25).normalize();
+        let n = Vec3::new(-0.6, 0.1, 1.0).normalize();
+        let m = bsdf::closure::valid_specular_normal(ng, -d, n);
+        assert!(
+            m.dot(n) < 0.999,
+            "the raised normal differs from the mapped one"
+        );
+        let specular_base = specular_base(&bsdf);
+        let base_n = if specular_base { m } else { n };
+        let frame = Frame::from_normal(base_n);
+        let g = Frame::from_normal(bsdf::closure::valid_specular_normal(ng, -d, ng));
+        if let BsdfInstance::Layered(l) = &mut bsdf {
+            l.prepare(g.to_local(-d));
+        }
+        let sp = ShadingPoint {
+            passes: false,
+            bsdf,
+            frame,
+            wi: frame.to_local(-d),
+            weight: Vec3::ONE,
+            subsurface: None,
+            smooth: Some(ng),
+            glossy_frame: Some(g),
+            inner_frame: (!specular_base).then(|| Frame::from_normal(m)),
+        };
+        let its = Intersection {
+            t: 1.0,
+            p: Vec3::ZERO,
+            ng,
+            ng_flipped: false,
+            ns: ng,
+            uv: glam::Vec2::ZERO,
+            mesh: 0,
+            instance: 0,
+            tri: 0,
+            b1: 0.0,
+            b2: 0.0,
+            material: 0,
+            emitter: None,
+        };
+        (sp, its, d)
+    }
+
+    /// The sampled directions' weights are `eval_cos / pdf` with the density `pdf` gives, and
+    /// their mean is the BSDF's integral over the sphere (estimated independently with
+    /// uniform directions): the multi-frame sampling is unbiased and consistent with its
+    /// density, as MIS needs.
+    #[test]
+    fn multi_frame_sampling_matches_its_density_and_integral() {
+        for metallic in [0.0, 1.0] {
+            let (sp, its, d) = coated(metallic, 0.2);
+            let n = 200_000u32;
+            let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+            for i in 0..n {
+                let mut ctx = Ctx::new(crate::sampler::SobolSampler::new(7, 3, i as u64));
+                let Some((wo, w, rec)) = sp.sample(&mut ctx, &its, d) else {
+                    continue;
+                };
+                let pdf = sp.pdf(wo);
+                assert!(
+                    (rec.pdf - pdf).abs() <= 1e-3 * pdf.max(1e-3),
+                    "sampled density {} against pdf {pdf}",
+                    rec.pdf
+                );
+                let f = sp.eval_cos(&its, d, wo);
+                let expect = f / pdf;
+                assert!(
+                    (w - expect).abs().max_element() <= 1e-3 * expect.max_element().max(1e-3),
+                    "weight {w} against eval/pdf {expect}"
+                );
+                let y = w.element_sum() as f64;
+                sum += y;
+                sum2 += y * y;
+            }
+            let mean = sum / n as f64;
+            let se = ((sum2 / n as f64 - mean * mean) / n as f64).sqrt();
+            // The integral with uniform directions on the sphere.
+            let (mut isum, mut isum2) = (0.0f64, 0.0f64);
+            let m = 400_000u32;
+            for i in 0..m {
+                let mut s = crate::sampler::Sampler::new(11, 5, i as u64);
+                let u = s.next_2d();
+                let z = 1.0 - 2.0 * u.x;
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                let phi = 2.0 * std::f32::consts::PI * u.y;
+                let wo = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+                let y = sp.eval_cos(&its, d, wo).element_sum() as f64 * 4.0 * std::f64::consts::PI;
+                isum += y;
+                isum2 += y * y;
+            }
+            let imean = isum / m as f64;
+            let ise = ((isum2 / m as f64 - imean * imean) / m as f64).sqrt();
+            let t = (mean - imean) / (se * se + ise * ise).sqrt();
+            assert!(
+                t.abs() < 4.0,
+                "metallic {metallic}: sampled mean {mean} against integral {imean} (t = {t})"
+            );
+        }
+    }
+
+    /// A smooth coat is a delta lobe: sampling returns its reflection with a finite weight
+    /// through the discrete branch, and the rough base still samples by its density.
+    #[test]
+    fn a_smooth_coat_over_a_raised_base_is_sampled_discretely() {
+        let (sp, its, d) = coated(0.0, 0.0);
+        let (mut discrete, mut rough) = (0, 0);
+        for i in 0..2000u64 {
+            let mut ctx = Ctx::new(crate::sampler::SobolSampler::new(3, 1, i));
+            if let Some((wo, w, rec)) = sp.sample(&mut ctx, &its, d) {
+                assert!(w.is_finite() && w.min_element() >= 0.0, "{w}");
+                if rec.measure == bsdf::Measure::Discrete {
+                    discrete += 1;
+                    let r = 2.0 * Vec3::Z.dot(-d) * Vec3::Z - -d;
+                    assert!(
+                        wo.dot(r) > 0.9999,
+                        "the coat reflects about the surface normal"
+                    );
+                } else {
+                    rough += 1;
+                }
+            }
+        }
+        assert!(discrete > 50 && rough > 500, "{discrete} {rough}");
+    }
 }

@@ -854,7 +854,8 @@ def coated_normal_map(kind):
     ``flakes``: car paint, a red metal with a Voronoi cell normal per flake under a smooth
     coat; ``tilted``: one strongly tilted normal over the whole ball (the coat keeps the
     ball's); ``tilted_coat_normal``: the same normal linked to Coat Normal too;
-    ``flakes_sheen``: the flakes under a sheen instead."""
+    ``flakes_sheen``: the flakes under a sheen instead; ``flakes_plastic``: under a coat over
+    a dielectric base."""
     def build():
         mat, nt, out = node_material("Coated_" + kind)
         ins = dict(Base_Color=(0.5, 0.02, 0.02, 1.0), Metallic=1.0, Roughness=0.35,
@@ -867,6 +868,10 @@ def coated_normal_map(kind):
             ins.update(Base_Color=(0.9, 0.8, 0.6, 1.0), Roughness=0.25)
         if kind == "flakes_sheen":
             ins.update(Coat_Weight=0.0, Sheen_Weight=1.0, Sheen_Roughness=0.3)
+        elif kind == "flakes_plastic":
+            # Varnish over a normal-mapped dielectric: three normals (coat, raised specular,
+            # mapped diffuse).
+            ins.update(Metallic=0.0)
         p = principled(nt, out, **ins)
         nt.links.new(nm.outputs["Normal"], p.inputs["Normal"])
         if kind == "tilted_coat_normal":
@@ -1278,6 +1283,7 @@ CASES = [
     ("emitter_hidden_from_camera", emitter_hidden_from_camera, 2, 256, 1024),
     ("principled_coat", principled_variant("coat"), 0, 256, 1024),
     ("coat_over_normal_mapped_flakes", coated_normal_map("flakes"), 0, 256, 1024),
+    ("coat_over_normal_mapped_dielectric", coated_normal_map("flakes_plastic"), 0, 256, 1024),
     ("coat_over_tilted_normal", coated_normal_map("tilted"), 0, 256, 1024),
     ("coat_normal_linked_tilted", coated_normal_map("tilted_coat_normal"), 0, 256, 1024),
     ("principled_sheen", principled_variant("sheen"), 0, 256, 1024),
