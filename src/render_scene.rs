@@ -839,6 +839,13 @@ impl RenderScene {
         !self.emitters[e as usize].is_delta() && self.visibility[e as usize].mis
     }
 
+    /// Whether any surface may let rays straight through (a transparent closure, or the
+    /// boundary of a volume without a surface shader).
+    #[inline]
+    pub fn has_passing_surfaces(&self) -> bool {
+        self.passes
+    }
+
     /// Whether the scene has lights whose shapes rays can meet (radius, area or angle).
     #[inline]
     pub fn has_light_shapes(&self) -> bool {

@@ -238,13 +238,25 @@ impl PathMats {
             let Some(its) = hit else {
                 return l;
             };
-            if depth >= end || !roulette(ctx, depth, &mut throughput) {
+            // At the path's last vertex a surface that lets the ray through (a volume's
+            // boundary, a transparent closure) still passes the light behind it, as Cycles
+            // goes on through transparent surfaces after its last bounce: a ray scattered in a
+            // medium reaches the world beyond its boundary. (Outside media the last segment's
+            // emission is found by `trace_lit` already.)
+            let at_end = depth >= end;
+            if at_end && !scene.has_passing_surfaces() {
+                return l;
+            }
+            if !at_end && !roulette(ctx, depth, &mut throughput) {
                 return l;
             }
             if BLUR {
                 ctx.blur = self.paths.filter_glossy.roughness(min_ray_pdf);
             }
             if !sp.shade(scene, ctx, &its, d, depth) {
+                return l;
+            }
+            if at_end && !sp.passes {
                 return l;
             }
             if sp.passes {
@@ -411,13 +423,25 @@ impl PathMis {
             let Some(its) = hit else {
                 return l;
             };
-            if depth >= end || !roulette(ctx, depth, &mut throughput) {
+            // At the path's last vertex a surface that lets the ray through (a volume's
+            // boundary, a transparent closure) still passes the light behind it, as Cycles
+            // goes on through transparent surfaces after its last bounce: a ray scattered in a
+            // medium reaches the world beyond its boundary. (Outside media the last segment's
+            // emission is found by `trace_lit` already.)
+            let at_end = depth >= end;
+            if at_end && !scene.has_passing_surfaces() {
+                return l;
+            }
+            if !at_end && !roulette(ctx, depth, &mut throughput) {
                 return l;
             }
             if BLUR {
                 ctx.blur = self.paths.filter_glossy.roughness(min_ray_pdf);
             }
             if !sp.shade(scene, ctx, &its, d, depth) {
+                return l;
+            }
+            if at_end && !sp.passes {
                 return l;
             }
             if sp.passes {

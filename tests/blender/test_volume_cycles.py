@@ -156,6 +156,30 @@ def white_cloud():
     return scenes.SceneInfo(bpy.context.scene, "white_cloud", {"volume_bounces": 8})
 
 
+def fog_lit_by_the_world(volume_bounces):
+    """A box of Principled Volume fog around a block, lit by the world alone (a grey sky):
+    at a scattering point the world is sampled as a light and reached by the phase function's
+    rays, which leave the fog through its boundary (a surface without a shader) even at the
+    last volume bounce, as in Cycles. Cycles' default of 0 volume bounces, and 1."""
+    def build():
+        _stage()
+        bpy.data.objects.remove(bpy.data.objects["Sun"], do_unlink=True)
+        bg = next(n for n in bpy.context.scene.world.node_tree.nodes if n.type == "BACKGROUND")
+        bg.inputs["Color"].default_value = (0.8, 0.85, 1.0, 1.0)
+        bg.inputs["Strength"].default_value = 1.0
+        mat, nt, out = _volume_only("WorldLitFog")
+        vol = nt.nodes.new("ShaderNodeVolumePrincipled")
+        vol.inputs["Color"].default_value = (0.8, 0.85, 0.9, 1.0)
+        vol.inputs["Density"].default_value = 0.4
+        nt.links.new(vol.outputs[0], out.inputs["Volume"])
+        scenes.add_box("Fog", (-1.5, -1.2, 0.01), (1.5, 1.2, 2.0), mat)
+        scenes.add_box("Block", (-0.4, -0.3, 0.0), (0.4, 0.3, 0.8),
+                       scenes.lambert("Block", (0.7, 0.3, 0.2)))
+        return scenes.SceneInfo(bpy.context.scene, "fog_lit_by_the_world",
+                                {"volume_bounces": volume_bounces})
+    return build
+
+
 def world_fog():
     """Fog in the world (the World Output's Volume: a Principled Volume) lit by a spot light,
     whose cone shows in the fog, and a small area light; the sun is removed, as Cycles' world
@@ -187,6 +211,8 @@ CASES = [
     ("glowing_volume", glowing_volume, 4, "path_mis", 1024),
     ("white_cloud", white_cloud, 12, "path_mis", 512),
     ("world_fog", world_fog, 4, "path_mis", 512),
+    ("fog_lit_by_the_world_0", fog_lit_by_the_world(0), 2, "path_mis", 256),
+    ("fog_lit_by_the_world_1", fog_lit_by_the_world(1), 2, "path_mis", 256),
 ]
 
 
