@@ -344,17 +344,9 @@ def specular_glossiness_scene(tmp_path):
     return g
 
 
-# (name, builder, world radiance or None for black)
-CASES = [("unlit", lambda tmp_path: unlit_scene(), None), ("webp", webp_scene, None),
-         ("skinned", skinned_scene, None),
-         ("specular_glossiness", specular_glossiness_scene, (0.3, 0.3, 0.33))]
-
-
-@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
-def test_file_agrees_with_cycles_import(tesela_bin, tmp_path, case):
-    name, build, world = case
-    gltf = build(tmp_path).write(tmp_path / f"{name}.gltf")
-    spp, bounces = 256, 4
+def file_agrees(tesela_bin, tmp_path, name, gltf, spp, bounces, world):
+    """Asserts that the CLI's render of ``gltf`` agrees with Cycles' render of Blender's import
+    of it (means, 8x8 blocks, edges), both under the constant world ``world`` (None: black)."""
     ref = cycles_of_import(gltf, tmp_path, spp, bounces, world)
     assert ref[..., :3].mean() > 0.01, "the Cycles reference is black: the scene is broken"
     extra = ["--background", *map(str, world)] if world else []
@@ -367,6 +359,19 @@ def test_file_agrees_with_cycles_import(tesela_bin, tmp_path, case):
     assert result.ok, f"{name}: Tesela (CLI) vs Cycles (import): {result}"
     assert edge_err <= 0.05, f"{name}: edges differ locally: median error {edge_err:.4f}"
     assert abs(grad_ratio - 1.0) <= 0.10, f"{name}: edge gradients differ: ratio {grad_ratio:.4f}"
+
+
+# (name, builder, world radiance or None for black)
+CASES = [("unlit", lambda tmp_path: unlit_scene(), None), ("webp", webp_scene, None),
+         ("skinned", skinned_scene, None),
+         ("specular_glossiness", specular_glossiness_scene, (0.3, 0.3, 0.33))]
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
+def test_file_agrees_with_cycles_import(tesela_bin, tmp_path, case):
+    name, build, world = case
+    gltf = build(tmp_path).write(tmp_path / f"{name}.gltf")
+    file_agrees(tesela_bin, tmp_path, name, gltf, 256, 4, world)
 
 
 def test_unlit_is_flat_and_casts_no_shadow(tesela_bin, tmp_path):
@@ -491,16 +496,5 @@ SAMPLE_CASES = [
 @pytest.mark.parametrize("case", SAMPLE_CASES, ids=[c[0] for c in SAMPLE_CASES])
 def test_sample_file_agrees_with_cycles_import(tesela_bin, tmp_path, case):
     name, spp = case
-    gltf = lit_sample(name, tmp_path)
-    bounces, world = 2, (0.3, 0.3, 0.33)
-    ref = cycles_of_import(gltf, tmp_path, spp, bounces, world)
-    assert ref[..., :3].mean() > 0.01, "the Cycles reference is black: the scene is broken"
-    got = run_tesela(tesela_bin, gltf, tmp_path / "tesela.exr", "path_mis", spp, bounces + 2,
-                     extra=["--background", *map(str, world)])
-    result = imgcompare.compare(got, ref, mean_tol=0.02, block_tol=0.05)
-    edge_err, grad_ratio = edge_agreement(got, ref)
-    print(f"{name}: {result}; edges: blurred median err {edge_err:.4f}, "
-          f"gradient ratio {grad_ratio:.4f}")
-    assert result.ok, f"{name}: Tesela (CLI) vs Cycles (import): {result}"
-    assert edge_err <= 0.05, f"{name}: edges differ locally: median error {edge_err:.4f}"
-    assert abs(grad_ratio - 1.0) <= 0.10, f"{name}: edge gradients differ: ratio {grad_ratio:.4f}"
+    file_agrees(tesela_bin, tmp_path, name, lit_sample(name, tmp_path), spp, 2,
+                (0.3, 0.3, 0.33))
