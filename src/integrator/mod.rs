@@ -277,25 +277,25 @@ impl ShadingPoint {
         // A coat has its own normal, as in Cycles: the Coat Normal input, else the surface's
         // (not the bumped one), raised to reflect above the surface; and a specular base below
         // it is raised as a specular lobe of its own is.
-        let coat = coat_normal(bsdf, &closure.kind).map(|c| {
-            let c = if c == Vec3::ZERO {
-                let ns = if closure.surface_normal == Vec3::ZERO {
-                    its.ns
-                } else {
-                    closure.surface_normal
-                };
-                if ns.dot(-d) < 0.0 { -ns } else { ns }
+        // The surface's own normal (Cycles' `sd->N`) on the viewer's side.
+        let surface_n = || {
+            let ns = if closure.surface_normal == Vec3::ZERO {
+                its.ns
             } else {
-                c
+                closure.surface_normal
             };
+            if ns.dot(-d) < 0.0 { -ns } else { ns }
+        };
+        let coat = coat_normal(bsdf, &closure.kind).map(|c| {
+            let c = if c == Vec3::ZERO { surface_n() } else { c };
             bsdf::closure::valid_specular_normal(ng_seen, -d, c)
         });
         // A sheen keeps the bumped normal itself (Cycles does not raise it) over a raised base.
         let sheen = (raise && sheen_on_top(bsdf) && specular_base(bsdf)).then_some(n);
-        if (coat.is_some() || sheen.is_some()) && raise && specular_base(bsdf) {
+        let coat = coat.or(sheen);
+        if coat.is_some() && raise && specular_base(bsdf) {
             n = bsdf::closure::valid_specular_normal(ng_seen, -d, n);
         }
-        let coat = coat.or(sheen);
         // Under a coat, Principled's dielectric base keeps its two normals: the specular
         // layer's raised, the diffuse's as mapped.
         let inner_frame = (coat.is_some() && raise && specular_diffuse_base(bsdf))
@@ -314,17 +314,7 @@ impl ShadingPoint {
                 })
                 .flatten(),
         };
-        let smooth = raise.then(|| {
-            if turned_away {
-                return n;
-            }
-            let ns = if closure.surface_normal == Vec3::ZERO {
-                its.ns
-            } else {
-                closure.surface_normal
-            };
-            if ns.dot(-d) < 0.0 { -ns } else { ns }
-        });
+        let smooth = raise.then(|| if turned_away { n } else { surface_n() });
         let wi = frame.to_local(-d);
         if let BsdfInstance::Layered(l) = &mut self.bsdf {
             // The layering for the direction its top lobe is queried with.
@@ -613,13 +603,12 @@ impl ShadingPoint {
         } else {
             let mut rec = BsdfQueryRecord::new(self.wi);
             let w = l.base.sample(&mut rec, u, u1);
-            let diffuse = match &l.base {
-                BaseLobe::Diffuse(_) | BaseLobe::Translucent(_) => true,
-                BaseLobe::CoatedDiffuse(b) => !b.pick(self.wi, u1).0,
-                BaseLobe::SpecularDiffuse(b) => !b.pick(self.wi, u1).0,
-                _ => false,
-            };
-            (&self.frame, rec, w, diffuse)
+            (
+                &self.frame,
+                rec,
+                w,
+                base_samples_diffuse(&l.base, self.wi, u1),
+            )
         };
         // The pair's weight comes from its value; a black lobe's direction still counts.
         if w == Vec3::ZERO && !bsdf::layered::sampled_direction(&rec) {
@@ -706,7 +695,6 @@ impl ShadingPoint {
     /// BSDF when the choice falls below its top.
     #[inline]
     fn sampled_diffuse(&self, wi: Vec3, u1: f32) -> bool {
-        use bsdf::layered::{BaseLobe, TopLobe};
         match &self.bsdf {
             BsdfInstance::Diffuse(_) | BsdfInstance::Translucent(_) | BsdfInstance::Sheen(_) => {
                 true
@@ -719,12 +707,7 @@ impl ShadingPoint {
                     return matches!(l.top, TopLobe::Sheen(_));
                 }
                 // The base's own choice, with the number Layered passes it.
-                match &l.base {
-                    BaseLobe::Diffuse(_) | BaseLobe::Translucent(_) => true,
-                    BaseLobe::CoatedDiffuse(inner) => !inner.pick(wi, u2).0,
-                    BaseLobe::SpecularDiffuse(inner) => !inner.pick(wi, u2).0,
-                    _ => false,
-                }
+                base_samples_diffuse(&l.base, wi, u2)
             }
             _ => false,
         }
@@ -838,6 +821,18 @@ fn coat_normal(bsdf: &BsdfInstance, kind: &crate::shading::ClosureKind) -> Optio
             Some(p.coat_normal)
         }
         _ => None,
+    }
+}
+
+/// Whether `base`, sampled for `wi` with the lobe-choice number `u1`, samples a diffuse lobe
+/// (its own diffuse, or the diffuse below its inner layer when the choice falls there).
+#[inline]
+fn base_samples_diffuse(base: &BaseLobe, wi: Vec3, u1: f32) -> bool {
+    match base {
+        BaseLobe::Diffuse(_) | BaseLobe::Translucent(_) => true,
+        BaseLobe::CoatedDiffuse(inner) => !inner.pick(wi, u1).0,
+        BaseLobe::SpecularDiffuse(inner) => !inner.pick(wi, u1).0,
+        _ => false,
     }
 }
 
