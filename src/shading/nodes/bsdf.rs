@@ -824,11 +824,6 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
         _ if cx.in_volume() => return compile_volume_closure(kind, cx, w),
         "ShaderNodeBsdfPrincipled" => {
             warn_smooth_oren_nayar(cx);
-            let coated =
-                cx.is_linked("Coat Weight") || cx.input_f32("Coat Weight").unwrap_or(0.0) > 0.0;
-            if coated && cx.is_linked("Coat Normal") {
-                cx.warn("the Coat Normal is not rendered; the coat follows the Normal input");
-            }
             let f = |cx: &mut NodeCx, id: &str, d: f32| cx.float(id, d);
             let c = |cx: &mut NodeCx, id: &str, d: Vec3| cx.color(id, d);
             let mut p = PrincipledSlots {
