@@ -12,7 +12,8 @@ Public API (all lengths in metres, angles in radians, colours linear RGB):
   Blender 4+'s "Specular IOR Level" (0.5 = physically based, 0 = no specular: Lambertian).
   Shortcuts: ``lambert(name, color)``, ``mirror(name, color)``, ``glass(name, ior)``,
   ``emitter(name, color, strength)``.
-* geometry: ``add_mesh``, ``add_quad``, ``add_box``, ``add_sphere``.
+* geometry: ``add_mesh``, ``add_quad``, ``add_box``, ``add_sphere``, ``uv_sphere_add``
+  (Blender's UV sphere operator, its faces in a fixed order: ``canonical_order``).
 * lights: ``add_point_light``, ``add_spot_light``, ``add_sun_light``, ``add_area_light``.
   Lights point along their local -Z, aimed with ``look_at``/``direction``.
 * ``add_camera(location, target, fov=..., ortho_scale=None)``.
@@ -214,10 +215,52 @@ def add_room(walls, floor=None, size=(4.0, 4.0, 2.6), window=(1.4, 1.0, 2.0)):
         add_quad(f"Front{i}", [(x, y0, z) for x, z in q][::-1], walls)
 
 
+def canonical_order(bm):
+    """Sorts the faces and edges of BMesh ``bm`` by their vertex indices, and returns it.
+
+    Blender's UV sphere (``bmesh.ops.create_uvsphere``, and so ``primitive_uv_sphere_add``) lists
+    the same faces and edges in an order that changes from call to call. The face order decides
+    the last bits of Blender's vertex normals (summed face by face) and the triangles' order in
+    a renderer's BVH, so a scene built twice would not render bit-identically."""
+    bm.verts.index_update()
+    n = len(bm.verts)
+
+    def verts(elem):
+        return tuple(v.index for v in elem.verts)
+
+    rank = {key: i for i, key in enumerate(sorted(verts(f) for f in bm.faces))}
+    bm.faces.sort(key=lambda f: rank[verts(f)])  # sort() wants numbers
+    bm.edges.sort(key=lambda e: min(verts(e)) * n + max(verts(e)))
+    bm.faces.index_update()
+    bm.edges.index_update()
+    return bm
+
+
+def uv_sphere_add(**kwargs):
+    """``bpy.ops.mesh.primitive_uv_sphere_add(**kwargs)`` with its faces in a fixed order (see
+    :func:`canonical_order`); returns the new (active) object."""
+    bpy.ops.mesh.primitive_uv_sphere_add(**kwargs)
+    ob = bpy.context.active_object
+    me = ob.data
+    bm = bmesh.new()
+    bm.from_mesh(me)
+    canonical_order(bm).to_mesh(me)
+    bm.free()
+    # Its edges' directions vary too (a BMesh edge's cannot be changed).
+    ends = [0] * (2 * len(me.edges))
+    me.edges.foreach_get("vertices", ends)
+    for i in range(0, len(ends), 2):
+        ends[i], ends[i + 1] = sorted(ends[i:i + 2])
+    me.edges.foreach_set("vertices", ends)
+    me.update()
+    return ob
+
+
 def add_sphere(name, center, radius, mat=None, segments=48, rings=24, smooth=True):
     """A UV sphere with outward normals."""
     bm = bmesh.new()
     bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, radius=radius)
+    canonical_order(bm)
     verts = [tuple(v.co) for v in bm.verts]
     faces = [tuple(v.index for v in f.verts) for f in bm.faces]
     bm.free()

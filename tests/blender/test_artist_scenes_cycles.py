@@ -84,7 +84,7 @@ def procedural_studio():
     nt2.links.new(dif.outputs[0], mix.inputs[1])
     nt2.links.new(gl.outputs[0], mix.inputs[2])
     floor.data.materials.append(m2)
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.35, location=(1.1, -0.4, 0.35))
+    scenes.uv_sphere_add(radius=0.35, location=(1.1, -0.4, 0.35))
     ball = bpy.context.active_object
     bpy.ops.object.shade_smooth()
     m3, _, glass = scenes.shader_only("Glass", "ShaderNodeBsdfGlass")
@@ -166,7 +166,7 @@ def geometry_kinds():
     else:
         bpy.ops.object.shade_smooth()
     cyl.data.materials.append(glossy("Cyl", (0.8, 0.3, 0.2), 0.2, 1.0))
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.35, location=(-0.2, 0.6, 0.35))
+    scenes.uv_sphere_add(radius=0.35, location=(-0.2, 0.6, 0.35))
     ball = bpy.context.active_object
     bpy.ops.object.shade_smooth()
     ball.scale = (-1, 1, 1)
@@ -276,8 +276,8 @@ def layered_principled():
     scenes.clear_scene()
 
     def ball(name, location):
-        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.4, location=location, segments=48,
-                                             ring_count=24)
+        scenes.uv_sphere_add(radius=0.4, location=location, segments=48,
+                             ring_count=24)
         ob = bpy.context.active_object
         bpy.ops.object.shade_smooth()
         m, _, p = _principled(name)

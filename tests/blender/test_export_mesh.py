@@ -33,6 +33,7 @@ def _sphere(name, smooth=True, segments=24, rings=12):
     bm.loops.layers.uv.new("UVMap")
     bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, radius=1.0,
                               calc_uvs=True)
+    scenes.canonical_order(bm)  # the bands below follow the face order
     bm.to_mesh(me)
     bm.free()
     me.polygons.foreach_set("use_smooth", np.full(len(me.polygons), smooth))

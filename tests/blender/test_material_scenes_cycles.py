@@ -342,8 +342,8 @@ def true_displacement_ball():
     surface(nt, out, node(nt, "ShaderNodeBsdfDiffuse", Color=(0.7, 0.7, 0.7, 1.0)).outputs[0])
     _displacement_output(mat, nt, out, disp)
     mat.displacement_method = "DISPLACEMENT"
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=0.6,
-                                         location=(0.0, 0.0, 0.75))
+    scenes.uv_sphere_add(segments=128, ring_count=64, radius=0.6,
+                         location=(0.0, 0.0, 0.75))
     ob = bpy.context.active_object
     ob.rotation_euler = (0.0, 0.0, math.radians(200.0))  # the seam faces the camera
     ob.data.materials.append(mat)
@@ -879,8 +879,8 @@ def coated_normal_map(kind):
         _sphere_stage(mat)
         # A ball as Blender makes one, with its UV map (tangent-space normal maps need one).
         bpy.data.objects.remove(bpy.data.objects["Ball"])
-        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.6, location=(0.0, 0.0, 0.6),
-                                             segments=64, ring_count=32)
+        scenes.uv_sphere_add(radius=0.6, location=(0.0, 0.0, 0.6),
+                             segments=64, ring_count=32)
         bpy.ops.object.shade_smooth()
         bpy.context.active_object.data.materials.append(mat)
     return build
@@ -1202,8 +1202,8 @@ def normals_up_ball():
     point against the faces' winding; a face is seen from the front by its winding, not by
     the normal. Cycles' shadow terminator offset is off (Tesela has none)."""
     lit_floor((-0.8, 0.3, -0.6), (0.0, 0.0, 0.4))
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=10, ring_count=6, radius=0.6,
-                                         location=(0.0, 0.0, 0.6))
+    scenes.uv_sphere_add(segments=10, ring_count=6, radius=0.6,
+                         location=(0.0, 0.0, 0.6))
     ob = bpy.context.active_object
     ob.data.materials.append(scenes.material("Ball", base_color=(0.8, 0.8, 0.8), roughness=0.3))
     ob.shadow_terminator_geometry_offset = 0.0
