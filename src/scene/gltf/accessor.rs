@@ -6,6 +6,7 @@ use json::accessor::{ComponentType, Type};
 use json::validation::Checked;
 
 use crate::scene::error::{LoadError, LoadErrorKind};
+use std::collections::HashMap;
 
 /// Accessors without a bufferView (all zeros, perhaps sparse) may hold at most this many
 /// elements, or as many as the file has binary bytes, whichever is more.
@@ -164,6 +165,10 @@ pub(crate) struct Reader<'a> {
     pub root: &'a json::Root,
     /// Buffer contents, each exactly `byteLength` long.
     pub buffers: &'a [&'a [u8]],
+    /// Accessors whose data was decoded from a compressed stream (a Draco primitive's):
+    /// accessor index -> tightly packed elements in the accessor's own component type, read
+    /// in place of a bufferView.
+    pub decoded: HashMap<usize, Vec<u8>>,
 }
 
 fn invalid(msg: String) -> LoadError {
@@ -261,17 +266,29 @@ impl<'a> Reader<'a> {
             .ok_or_else(|| invalid(format!("{}: count {count} is too large", tag())))?;
         let normalized = acc.normalized;
         let mut data: Vec<T>;
-        if let Some(vi) = acc.buffer_view {
-            let vi = vi.value();
-            let (bytes, stride) = self.view(vi, &tag())?;
-            let stride = stride.unwrap_or(elem);
+        let source = match (self.decoded.get(&ai), acc.buffer_view) {
+            // Decoded elements are packed from the start; a byteOffset belongs to a view.
+            (Some(bytes), _) => Some((bytes.as_slice(), elem, 0, "the decoded data".to_string())),
+            (None, Some(vi)) => {
+                let vi = vi.value();
+                let (bytes, stride) = self.view(vi, &tag())?;
+                let off = acc.byte_offset.map(|o| o.0).unwrap_or(0);
+                Some((
+                    bytes,
+                    stride.unwrap_or(elem),
+                    off,
+                    format!("bufferView {vi}"),
+                ))
+            }
+            (None, None) => None,
+        };
+        if let Some((bytes, stride, off, src)) = source {
             if stride < elem {
                 return Err(invalid(format!(
-                    "{}: bufferView {vi} byteStride {stride} is smaller than the {elem}-byte element",
+                    "{}: {src} byteStride {stride} is smaller than the {elem}-byte element",
                     tag()
                 )));
             }
-            let off = acc.byte_offset.map(|o| o.0).unwrap_or(0);
             if count > 0 {
                 let need = (count as u64 - 1)
                     .checked_mul(stride as u64)
@@ -281,7 +298,7 @@ impl<'a> Reader<'a> {
                     Some(n) if n <= bytes.len() as u64 => {}
                     _ => {
                         return Err(invalid(format!(
-                            "{}: byteOffset+length {} exceeds bufferView {vi} of {} bytes",
+                            "{}: byteOffset+length {} exceeds {src} of {} bytes",
                             tag(),
                             need.map(|n| n.to_string())
                                 .unwrap_or_else(|| "(overflow)".into()),
@@ -291,7 +308,7 @@ impl<'a> Reader<'a> {
                 }
             } else if off > bytes.len() as u64 {
                 return Err(invalid(format!(
-                    "{}: byteOffset {off} exceeds bufferView {vi} of {} bytes",
+                    "{}: byteOffset {off} exceeds {src} of {} bytes",
                     tag(),
                     bytes.len()
                 )));
@@ -488,6 +505,7 @@ mod tests {
         let rd = Reader {
             root: &r,
             buffers: &bufs,
+            decoded: HashMap::new(),
         };
         assert_eq!(
             rd.read_f32(0, "t", Type::Vec3).unwrap().data,
@@ -526,6 +544,7 @@ mod tests {
         let rd = Reader {
             root: &r,
             buffers: &bufs,
+            decoded: HashMap::new(),
         };
         let s = Type::Scalar;
         assert_eq!(
@@ -555,6 +574,7 @@ mod tests {
         let rd = Reader {
             root: &r,
             buffers: &bufs,
+            decoded: HashMap::new(),
         };
         assert_eq!(rd.read(0, "m", &decode_f32).unwrap().data, [1., 2., 3., 4.]);
     }
@@ -578,6 +598,7 @@ mod tests {
         let rd = Reader {
             root: &r,
             buffers: &bufs,
+            decoded: HashMap::new(),
         };
         let e = rd
             .read_f32(0, "POSITION of mesh 0 primitive 1", Type::Vec3)
@@ -628,6 +649,7 @@ mod tests {
         let rd = Reader {
             root: &r,
             buffers: &bufs,
+            decoded: HashMap::new(),
         };
         let s = Type::Scalar;
         assert_eq!(rd.read_f32(0, "s", s).unwrap().data, [10., 20., 12., 30.]);

@@ -554,8 +554,35 @@ impl<'a> Loader<'a> {
     }
 
     /// Reads and triangulates one primitive in local space; `None` for skipped modes. Reads
-    /// the optional attributes `needs` asks for.
+    /// the optional attributes `needs` asks for. A Draco-compressed primitive is decoded
+    /// first, and its accessors read from the decoded data.
     fn local_prim(
+        &mut self,
+        mi: usize,
+        pi: usize,
+        prim: &json::mesh::Primitive,
+        weights: Option<&[f32]>,
+        skin: Option<&super::skin::Skinning>,
+        needs: &Needs,
+    ) -> Result<Option<LocalPrim>, LoadError> {
+        let raw_prim = member(self.raw_item("meshes", mi), "primitives")
+            .and_then(|p| p.get(pi))
+            .unwrap_or(&Value::Null);
+        let who = format!("mesh {mi} primitive {pi}");
+        // The scene's own limits bound one decode; the loader counts the scene's total.
+        let limits = (MAX_VERTICES, MAX_TRIANGLES);
+        let decoded = super::draco::decode(&self.reader, raw_prim, prim, &who, limits)?;
+        let Some(decoded) = decoded else {
+            return self.read_prim(mi, pi, prim, weights, skin, needs);
+        };
+        self.reader.decoded = decoded;
+        let prim_data = self.read_prim(mi, pi, prim, weights, skin, needs);
+        self.reader.decoded.clear();
+        prim_data
+    }
+
+    /// [`Self::local_prim`] once the primitive's data is readable through the accessors.
+    fn read_prim(
         &mut self,
         mi: usize,
         pi: usize,

@@ -15,6 +15,7 @@ mod accessor;
 mod camera;
 mod container;
 mod document;
+mod draco;
 mod image_file;
 mod instances;
 mod lights;
@@ -52,6 +53,7 @@ const MAX_VERTICES: usize = 1 << 25;
 /// Extensions that may appear in `extensionsRequired`.
 const SUPPORTED_REQUIRED: &[&str] = &[
     "KHR_mesh_quantization",
+    "KHR_draco_mesh_compression",
     "EXT_mesh_gpu_instancing",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
@@ -80,6 +82,7 @@ const SUPPORTED_REQUIRED: &[&str] = &[
 /// reports it. Volume attenuation, which is not rendered yet, is reported by the loader.
 const UNDERSTOOD: &[&str] = &[
     "KHR_mesh_quantization",
+    "KHR_draco_mesh_compression",
     "EXT_mesh_gpu_instancing",
     "KHR_texture_transform",
     "KHR_materials_emissive_strength",
@@ -231,7 +234,11 @@ fn load_parsed(
         root,
         raw,
         base_dir,
-        reader: accessor::Reader { root, buffers },
+        reader: accessor::Reader {
+            root,
+            buffers,
+            decoded: HashMap::new(),
+        },
         scene: Scene {
             warnings,
             ..Default::default()
