@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs every test of the project on a fresh machine, installing what the tests need:
-#   - Debian's Blender 3.4 (+ python3-numpy, Xvfb for its GUI) and the Khronos glTF validator (npm),
+#   - Debian's Blender 3.4 (+ python3-numpy, Xvfb for its GUI) and the Khronos glTF validator and gltfpack (npm),
 #   - a virtual environment .venv with PyPI's bpy (Blender 5.x as a Python module), numpy, pytest,
 #     OpenEXR (reads the multi-layer EXRs of the pass tests), dask distributed and tesela-farm
 #     (farm/, editable: the render-farm tests),
@@ -43,6 +43,12 @@ if [[ "${TESELA_SKIP_INSTALL:-0}" != 1 ]]; then
         npm install -s --prefix .venv/node gltf-validator >/dev/null 2>&1 \
             || echo "warning: npm could not install gltf-validator; validator tests will skip"
     fi
+    if command -v npm >/dev/null && [[ ! -x .venv/node/node_modules/.bin/gltfpack ]]; then
+        log "installing gltfpack, meshoptimizer's glTF packer (npm)"
+        mkdir -p .venv/node
+        npm install -s --prefix .venv/node gltfpack >/dev/null 2>&1 \
+            || echo "warning: npm could not install gltfpack; meshopt file tests will skip"
+    fi
 fi
 
 # The denoiser library for the tests and the renderer they start (unless one is chosen already).
@@ -69,4 +75,5 @@ cargo test -q --profile ci
 log "pytest tests/blender"
 export TESELA_BIN="$ROOT/target/release/tesela"
 export GLTF_VALIDATOR="$ROOT/.venv/node/node_modules/.bin/gltf_validator"
+export GLTFPACK="$ROOT/.venv/node/node_modules/.bin/gltfpack"
 .venv/bin/python -m pytest -q tests/blender

@@ -391,7 +391,7 @@ fn other_broken_files_exit_with_the_load_error_status() {
     d["accessors"][1]["count"] = json!(2);
     cases.push(("index", d, "out of range for 2 vertices"));
     let mut d = triangle_doc(&TRI);
-    d["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
+    d["extensionsRequired"] = json!(["KHR_texture_basisu"]);
     cases.push(("ext", d, "unsupported required extension"));
     let mut d = triangle_doc(&TRI);
     d["buffers"][0]["uri"] = json!("missing.bin");

@@ -7,6 +7,8 @@ sees.
   file, the extension required.
 - ``KHR_draco_mesh_compression`` (Blender's own exporter with Draco compression on, web
   pipelines): quantized, reordered geometry decoded from a Draco bitstream.
+- ``EXT_meshopt_compression`` (gltfpack, glTF-Transform): meshoptimizer streams over quantized
+  attributes, on views of a fallback buffer that holds no data.
 - ``KHR_materials_unlit`` (three.js's MeshBasicMaterial, Sketchfab's shadeless assets, baked
   lighting): Blender's importer makes the base colour an Emission of strength 1 seen by camera
   rays only, every other ray passing through, so the surface shows its colour flat and casts no
@@ -23,8 +25,10 @@ Criteria as tests/blender/test_lights_cycles.py: means within 2%, 8x8 blocks wit
 import base64
 import json
 import math
+import os
 import struct
 import shutil
+import subprocess
 import zlib
 from pathlib import Path
 
@@ -346,11 +350,11 @@ def specular_glossiness_scene(tmp_path):
     return g
 
 
-def draco_scene(tmp_path):
-    """A scene built in Blender and written by Blender's own exporter with Draco compression
-    on (its defaults: positions quantized to 14 bits, normals 10, UVs 12): a smooth UV sphere
-    with an image texture, a subdivided Suzanne of flat and smooth faces in a glossy
-    dielectric, a floor, and an emitting panel, seen by the scene's camera."""
+def blender_scene(tmp_path, name, **export):
+    """A scene built in Blender and written by Blender's own exporter with the options
+    ``export``: a smooth UV sphere with an image texture, a subdivided Suzanne of flat and
+    smooth faces in a glossy dielectric, a floor, and an emitting panel, seen by the scene's
+    camera."""
     scenes.clear_scene()
     scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
                     scenes.material("Floor", (0.55, 0.55, 0.5), roughness=0.7))
@@ -387,20 +391,28 @@ def draco_scene(tmp_path):
     scenes.add_camera((1.8, -4.2, 2.2), (0.0, 0.0, 0.5), fov=math.radians(40.0))
     scene = bpy.context.scene
     scene.render.resolution_x = scene.render.resolution_y = SIZE
-    path = tmp_path / "draco" / "draco.gltf"
+    path = tmp_path / name / f"{name}.gltf"
     path.parent.mkdir()
     bpy.ops.export_scene.gltf(filepath=str(path), export_format="GLTF_SEPARATE",
-                              export_cameras=True, export_draco_mesh_compression_enable=True)
+                              export_cameras=True, **export)
+    return path
+
+
+def draco_scene(tmp_path):
+    """:func:`blender_scene` with Draco compression on (the exporter's defaults: positions
+    quantized to 14 bits, normals 10, UVs 12)."""
+    path = blender_scene(tmp_path, "draco", export_draco_mesh_compression_enable=True)
     doc = json.loads(path.read_text())
     assert "KHR_draco_mesh_compression" in doc.get("extensionsRequired", []), \
         "the exporter did not compress the meshes"
     return path
 
 
-def file_agrees(tesela_bin, tmp_path, name, gltf, spp, bounces, world):
+def file_agrees(tesela_bin, tmp_path, name, gltf, spp, bounces, world, imported=None):
     """Asserts that the CLI's render of ``gltf`` agrees with Cycles' render of Blender's import
-    of it (means, 8x8 blocks, edges), both under the constant world ``world`` (None: black)."""
-    ref = cycles_of_import(gltf, tmp_path, spp, bounces, world)
+    of it, or of the file ``imported`` (means, 8x8 blocks, edges), both under the constant
+    world ``world`` (None: black)."""
+    ref = cycles_of_import(imported or gltf, tmp_path, spp, bounces, world)
     assert ref[..., :3].mean() > 0.01, "the Cycles reference is black: the scene is broken"
     extra = ["--background", *map(str, world)] if world else []
     got = run_tesela(tesela_bin, gltf, tmp_path / "tesela.exr", "path_mis", spp, bounces + 2,
@@ -429,6 +441,25 @@ def test_file_agrees_with_cycles_import(tesela_bin, tmp_path, case):
 
 def test_draco_file_from_blender_agrees_with_cycles_import(tesela_bin, tmp_path):
     file_agrees(tesela_bin, tmp_path, "draco", draco_scene(tmp_path), 256, 4, (0.2, 0.2, 0.22))
+
+
+@pytest.mark.parametrize("flags", [["-c"], ["-cc"], ["-c", "-vpf"]], ids=["c", "cc", "c_vpf"])
+def test_meshopt_file_from_gltfpack_agrees_with_cycles(tesela_bin, tmp_path, flags):
+    """gltfpack (meshoptimizer's glTF packer; npm) compresses Blender's export with
+    EXT_meshopt_compression over quantized attributes (octahedral normal filters; ``-vpf``
+    float positions through the exponential filter). Blender's importer does not read meshopt,
+    so Cycles renders its import of the uncompressed file the packed one was made from."""
+    gltfpack = os.environ.get("GLTFPACK") or shutil.which("gltfpack")
+    if not gltfpack or not Path(gltfpack).exists():
+        pytest.skip("gltfpack (npm) is not installed")
+    plain = blender_scene(tmp_path, "plain")
+    packed = tmp_path / "packed.glb"
+    subprocess.run([gltfpack, "-i", str(plain), "-o", str(packed), *flags], check=True,
+                   capture_output=True, timeout=120)
+    header = packed.read_bytes()[:4096]
+    assert b"EXT_meshopt_compression" in header, "gltfpack did not compress the meshes"
+    file_agrees(tesela_bin, tmp_path, "meshopt", packed, 256, 4, (0.2, 0.2, 0.22),
+                imported=plain)
 
 
 def test_unlit_is_flat_and_casts_no_shadow(tesela_bin, tmp_path):

@@ -165,6 +165,9 @@ pub(crate) struct Reader<'a> {
     pub root: &'a json::Root,
     /// Buffer contents, each exactly `byteLength` long.
     pub buffers: &'a [&'a [u8]],
+    /// BufferViews decoded from a compressed stream (meshopt): view index -> its bytes, read
+    /// in place of the view's buffer range.
+    pub views: &'a HashMap<usize, Vec<u8>>,
     /// Accessors whose data was decoded from a compressed stream (a Draco primitive's):
     /// accessor index -> tightly packed elements in the accessor's own component type, read
     /// in place of a bufferView.
@@ -193,6 +196,14 @@ impl<'a> Reader<'a> {
                 self.root.buffer_views.len()
             ))
         })?;
+        let stride = match view.byte_stride {
+            Some(s) if s.0 == 0 => None,
+            Some(s) => Some(s.0),
+            None => None,
+        };
+        if let Some(bytes) = self.views.get(&vi) {
+            return Ok((bytes, stride));
+        }
         let bi = view.buffer.value();
         let buf = *self.buffers.get(bi).ok_or_else(|| {
             invalid(format!(
@@ -204,14 +215,7 @@ impl<'a> Reader<'a> {
         let len = view.byte_length.0;
         let end = off.checked_add(len);
         match end {
-            Some(end) if end <= buf.len() as u64 => {
-                let stride = match view.byte_stride {
-                    Some(s) if s.0 == 0 => None,
-                    Some(s) => Some(s.0),
-                    None => None,
-                };
-                Ok((&buf[off as usize..end as usize], stride))
-            }
+            Some(end) if end <= buf.len() as u64 => Ok((&buf[off as usize..end as usize], stride)),
             _ => Err(invalid(format!(
                 "bufferView {vi}: byteOffset {off} + byteLength {len} exceeds buffer {bi} of {} bytes",
                 buf.len()
@@ -505,6 +509,7 @@ mod tests {
         let rd = Reader {
             root: &r,
             buffers: &bufs,
+            views: &HashMap::new(),
             decoded: HashMap::new(),
         };
         assert_eq!(
@@ -544,6 +549,7 @@ mod tests {
         let rd = Reader {
             root: &r,
             buffers: &bufs,
+            views: &HashMap::new(),
             decoded: HashMap::new(),
         };
         let s = Type::Scalar;
@@ -574,6 +580,7 @@ mod tests {
         let rd = Reader {
             root: &r,
             buffers: &bufs,
+            views: &HashMap::new(),
             decoded: HashMap::new(),
         };
         assert_eq!(rd.read(0, "m", &decode_f32).unwrap().data, [1., 2., 3., 4.]);
@@ -598,6 +605,7 @@ mod tests {
         let rd = Reader {
             root: &r,
             buffers: &bufs,
+            views: &HashMap::new(),
             decoded: HashMap::new(),
         };
         let e = rd
@@ -649,6 +657,7 @@ mod tests {
         let rd = Reader {
             root: &r,
             buffers: &bufs,
+            views: &HashMap::new(),
             decoded: HashMap::new(),
         };
         let s = Type::Scalar;

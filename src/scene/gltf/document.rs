@@ -54,7 +54,7 @@ impl Document {
             let c = container::split(&bytes)?;
             let raw = parse_json(c.json)?;
             let root = typed_document(&raw)?;
-            let buffers = resolve_buffers(&root, c.bin, Some(&base))?;
+            let buffers = resolve_buffers(&raw, &root, c.bin, Some(&base))?;
             Ok((raw, buffers.into_iter().map(|b| b.into_owned()).collect()))
         };
         let (raw, buffers) = parse().map_err(|e| e.in_file(&name))?;
@@ -99,7 +99,8 @@ impl Document {
             .in_file(&self.name));
         }
         for (i, (b, data)) in root.buffers.iter().zip(&buffers).enumerate() {
-            if (data.len() as u64) < b.byte_length.0 {
+            if (data.len() as u64) < b.byte_length.0 && !super::meshopt::is_fallback_buffer(raw, i)
+            {
                 return Err(LoadError::new(
                     LoadErrorKind::Invalid,
                     format!(

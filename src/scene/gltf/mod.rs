@@ -21,6 +21,7 @@ mod instances;
 mod lights;
 mod material;
 mod mesh;
+mod meshopt;
 mod skin;
 mod tangents;
 mod uri;
@@ -54,6 +55,8 @@ const MAX_VERTICES: usize = 1 << 25;
 const SUPPORTED_REQUIRED: &[&str] = &[
     "KHR_mesh_quantization",
     "KHR_draco_mesh_compression",
+    "EXT_meshopt_compression",
+    "KHR_meshopt_compression",
     "EXT_mesh_gpu_instancing",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
@@ -83,6 +86,8 @@ const SUPPORTED_REQUIRED: &[&str] = &[
 const UNDERSTOOD: &[&str] = &[
     "KHR_mesh_quantization",
     "KHR_draco_mesh_compression",
+    "EXT_meshopt_compression",
+    "KHR_meshopt_compression",
     "EXT_mesh_gpu_instancing",
     "KHR_texture_transform",
     "KHR_materials_emissive_strength",
@@ -178,7 +183,7 @@ fn load_inner(
     let c = container::split(bytes)?;
     let raw = parse_json(c.json)?;
     let root = typed_document(&raw)?;
-    let buffers = resolve_buffers(&root, c.bin, base_dir)?;
+    let buffers = resolve_buffers(&raw, &root, c.bin, base_dir)?;
     let buffer_refs: Vec<&[u8]> = buffers.iter().map(|b| &b[..]).collect();
     load_parsed(&raw, &root, &buffer_refs, base_dir, options).map(|(scene, _)| scene)
 }
@@ -230,6 +235,7 @@ fn load_parsed(
             ));
         }
     }
+    let views = meshopt::decode_views(raw, buffers)?;
     let mut loader = Loader {
         root,
         raw,
@@ -237,6 +243,7 @@ fn load_parsed(
         reader: accessor::Reader {
             root,
             buffers,
+            views: &views,
             decoded: HashMap::new(),
         },
         scene: Scene {
@@ -350,6 +357,7 @@ fn locate_error(v: &Value) -> Option<String> {
 
 /// Fetches every buffer, trimmed to its `byteLength`.
 fn resolve_buffers<'a>(
+    raw: &Value,
     root: &json::Root,
     bin: Option<&'a [u8]>,
     base_dir: Option<&Path>,
@@ -358,6 +366,11 @@ fn resolve_buffers<'a>(
     for (i, b) in root.buffers.iter().enumerate() {
         let want = b.byte_length.0;
         let data: Cow<'a, [u8]> = match &b.uri {
+            // Every view on a meshopt fallback buffer is decoded from another buffer.
+            None if meshopt::is_fallback_buffer(raw, i) => {
+                out.push(Cow::Borrowed(&[][..]));
+                continue;
+            }
             None => {
                 if i != 0 {
                     return Err(invalid(format!(
