@@ -98,11 +98,10 @@ impl Sheen {
 
     /// `∫ f cos dωo` for this `wi`: `colour · albedo(cos θi)` (zero where Cycles drops the
     /// lobe). The Principled BSDF attenuates the layers below by
-    /// `1 - max(colour) · albedo` (see [`super::layered::Layer`]).
+    /// `1 - max(colour) · albedo` (see [`super::layered::Layer`]). A `wi` below the lobe's
+    /// normal (a normal map tilted away from the viewer) reads the grazing parameters, as
+    /// Cycles' table lookup clamps `cos θi` to 0: the lobe stays, reflecting above its normal.
     pub fn albedo(&self, wi: Vec3) -> Vec3 {
-        if wi.z <= 0.0 {
-            return Vec3::ZERO;
-        }
         match ltc(wi.z, self.roughness) {
             Some((_, _, e)) => self.color * e,
             None => Vec3::ZERO,
@@ -126,9 +125,6 @@ impl Sheen {
 impl Bsdf for Sheen {
     fn sample(&self, rec: &mut BsdfQueryRecord, u: Vec2, _u1: f32) -> Vec3 {
         let wi = rec.wi;
-        if wi.z <= 0.0 {
-            return Vec3::ZERO;
-        }
         let Some((a, b, e)) = ltc(wi.z, self.roughness) else {
             return Vec3::ZERO;
         };
@@ -150,7 +146,7 @@ impl Bsdf for Sheen {
 
     fn eval(&self, rec: &BsdfQueryRecord) -> Vec3 {
         let (wi, wo) = (rec.wi, rec.wo);
-        if wi.z <= 0.0 || wo.z <= 0.0 {
+        if wo.z <= 0.0 {
             return Vec3::ZERO;
         }
         let Some((a, b, e)) = ltc(wi.z, self.roughness) else {
@@ -161,9 +157,6 @@ impl Bsdf for Sheen {
 
     fn pdf(&self, rec: &BsdfQueryRecord) -> f32 {
         let wi = rec.wi;
-        if wi.z <= 0.0 {
-            return 0.0;
-        }
         let Some((a, b, _)) = ltc(wi.z, self.roughness) else {
             return 0.0;
         };
@@ -177,5 +170,30 @@ impl Bsdf for Sheen {
     /// Cycles counts this lobe among the diffuse closures.
     fn eval_split(&self, rec: &BsdfQueryRecord) -> [Vec3; 2] {
         [self.eval(rec), Vec3::ZERO]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A viewer below the lobe's normal (a tilted normal map) still sees the lobe, with the
+    /// grazing parameters, reflecting above the normal: Cycles clamps `cos θi` in its table
+    /// lookups and drops nothing.
+    #[test]
+    fn a_viewer_below_the_normal_sees_the_grazing_lobe() {
+        let s = Sheen::new(Vec3::ONE, 0.5);
+        let below = Vec3::new(0.6, 0.0, -0.8);
+        let grazing = Vec3::new(1.0, 0.0, 0.0);
+        assert!(s.albedo(below).x > 0.0);
+        assert_eq!(s.albedo(below), s.albedo(grazing));
+        let wo = Vec3::new(-0.3, 0.2, 0.9).normalize();
+        let f = s.eval(&BsdfQueryRecord::pair(below, wo));
+        assert!(f.x > 0.0 && f == s.eval(&BsdfQueryRecord::pair(grazing, wo)));
+        let mut rec = BsdfQueryRecord::pair(below, Vec3::ZERO);
+        let w = s.sample(&mut rec, Vec2::new(0.3, 0.7), 0.5);
+        assert!(w.x > 0.0 && rec.wo.z > 0.0 && rec.pdf > 0.0);
+        // Below the lobe's normal on the way out, nothing.
+        assert_eq!(s.eval(&BsdfQueryRecord::pair(below, -wo)), Vec3::ZERO);
     }
 }

@@ -520,7 +520,9 @@ impl ShadingPoint {
             }
         };
         let base = att * fb;
-        let top = ft * wo_g.z.abs() * Self::bump_term(g.n, ns, wo, is_eval, false);
+        // A sheen on top is one of Cycles' diffuse closures, corrected as one.
+        let top_diffuse = matches!(l.top, bsdf::layered::TopLobe::Sheen(_));
+        let top = ft * wo_g.z.abs() * Self::bump_term(g.n, ns, wo, is_eval, top_diffuse);
         let p = l.top_probability(wi_g);
         (base + top, p * pt + (1.0 - p) * pb)
     }
@@ -632,7 +634,9 @@ impl ShadingPoint {
     #[inline]
     fn diffuse_lobe(&self) -> bool {
         match self.bsdf {
-            BsdfInstance::Diffuse(_) | BsdfInstance::Translucent(_) => true,
+            BsdfInstance::Diffuse(_) | BsdfInstance::Translucent(_) | BsdfInstance::Sheen(_) => {
+                true
+            }
             BsdfInstance::Toon(t) => !t.glossy,
             _ => false,
         }
