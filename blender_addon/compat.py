@@ -350,11 +350,38 @@ def light_is_portal(light):
     return bool(getattr(getattr(light, "cycles", None), "is_portal", False))
 
 
-def light_linking_used(obj):
-    """Whether an emitter object links its light or shadow to a collection (4.0+)."""
+def light_linking_collections(obj):
+    """(receiver collection, blocker collection) of an object's light linking (4.0+; None
+    where unset or before 4.0)."""
     link = getattr(obj, "light_linking", None)
-    return link is not None and (getattr(link, "receiver_collection", None) is not None
-                                 or getattr(link, "blocker_collection", None) is not None)
+    if link is None:
+        return None, None
+    return (getattr(link, "receiver_collection", None),
+            getattr(link, "blocker_collection", None))
+
+
+def light_linking_states(coll):
+    """{object name: 'INCLUDE' | 'EXCLUDE'}: each object's state in a light linking
+    collection. A child collection's state covers every object under it; objects met more
+    than once take the last state met, children before the collection's own objects (the
+    order Blender resolves them in). The link states live on collection_objects and
+    collection_children, parallel to objects and children (4.0+)."""
+    states = {}
+
+    def under(c, state, seen):
+        if c.name in seen:
+            return
+        seen.add(c.name)
+        for child in c.children:
+            under(child, state, seen)
+        for o in c.objects:
+            states[o.name] = state
+
+    for child, link in zip(coll.children, getattr(coll, "collection_children", ())):
+        under(child, link.light_linking.link_state, set())
+    for o, link in zip(coll.objects, getattr(coll, "collection_objects", ())):
+        states[o.name] = link.light_linking.link_state
+    return states
 
 
 def color_layers(mesh):

@@ -14,7 +14,7 @@ use crate::instancing::InstanceAccel;
 use crate::integrator::MAX_TRANSPARENT;
 use crate::integrator::mis_weight;
 use crate::medium::{self, Medium};
-use crate::scene::{Light, ObjectInfo, Scene};
+use crate::scene::{Light, LightLinks, ObjectInfo, Scene};
 use crate::scene::{LightShape, LightVisibility};
 use crate::shading::globals::ray;
 use crate::shading::globals::{ShadeEnv, ShaderGlobals, to_blender};
@@ -217,6 +217,10 @@ pub struct Ctx {
     /// through transparent surfaces (its origin is then not that vertex): MIS weights of the
     /// emission it meets take light sampling's densities from there. `None`: the origin.
     pub mis_from: Option<Vec3>,
+    /// Whose light the current ray carries ([`RenderScene::receiver_at`]): the receiver set
+    /// plus one of the object whose closure scattered it; 0 for camera rays, rays scattered
+    /// in media and scenes without light linking (every light reaches them).
+    pub receiver: u8,
     /// The medium the current path segment travels in ([`crate::medium`]); clear outside
     /// interiors with a volume. Shadow rays start in it.
     pub medium: Medium,
@@ -267,6 +271,7 @@ impl Ctx {
             blur: 0.0,
             walks_subsurface: false,
             mis_from: None,
+            receiver: 0,
             medium: Medium::default(),
             camera_memo: false,
             camera_hit: None,
@@ -347,6 +352,63 @@ pub struct RenderScene {
     triangles: usize,
     /// How shadow rays choose a light (kept to rebuild the emitters).
     choice: LightChoice,
+    /// Light and shadow linking; `None` in scenes without it.
+    linking: Option<Box<Linking>>,
+}
+
+/// Light and shadow linking over the emitters ([`LightLinks`]).
+struct Linking {
+    /// Each emitter's receiver sets and blocker sets (bit masks).
+    lights: Vec<u64>,
+    shadowed_by: Vec<u64>,
+    /// Each receiver set's light choices, as [`RenderScene::lights`] and
+    /// [`RenderScene::mis_lights`] over the emitters that light the set alone: an unlinked
+    /// emitter is never chosen, so its emission met by a BSDF-sampled ray has no emitter-sampling
+    /// share either.
+    choices: Vec<(LightSampler, Option<LightSampler>)>,
+}
+
+impl Linking {
+    /// The linking of `emitters` (with their `links`, `powers` and `bounds`), or `None` when
+    /// no emitter is linked.
+    fn new(
+        scene: &Scene,
+        links: &[LightLinks],
+        (powers, bounds): (&[f32], &[Option<LightBounds>]),
+        constant_world: Option<u32>,
+        radius: f32,
+        choice: LightChoice,
+    ) -> Option<Box<Linking>> {
+        let unlinked =
+            |l: &LightLinks| l.lights == LightLinks::ALL && l.shadowed_by == LightLinks::ALL;
+        if links.iter().all(unlinked) {
+            return None;
+        }
+        let objects = (scene.meshes.iter().map(|m| &m.attrs.object))
+            .chain(scene.instances.iter().map(|i| &i.object));
+        let sets = objects
+            .map(|o| o.links.receiver_set as usize + 1)
+            .max()
+            .unwrap_or(1);
+        let choices = (0..sets)
+            .map(|s| {
+                let mut p: Vec<f32> = (powers.iter().zip(links))
+                    .map(|(&p, l)| if l.lights >> s & 1 != 0 { p } else { 0.0 })
+                    .collect();
+                let lights = LightSampler::with_bounds(&p, bounds, radius, choice);
+                let mis = constant_world.map(|b| {
+                    p[b as usize] = 0.0;
+                    LightSampler::with_bounds(&p, bounds, radius, choice)
+                });
+                (lights, mis)
+            })
+            .collect();
+        Some(Box::new(Linking {
+            lights: links.iter().map(|l| l.lights).collect(),
+            shadowed_by: links.iter().map(|l| l.shadowed_by).collect(),
+            choices,
+        }))
+    }
 }
 
 /// Each material's compiled program, and what the compiler reported (once each).
@@ -428,6 +490,7 @@ struct LightParts {
     suns: Vec<u32>,
     lights: LightSampler,
     mis_lights: Option<LightSampler>,
+    linking: Option<Box<Linking>>,
 }
 
 impl LightParts {
@@ -445,6 +508,7 @@ impl LightParts {
         let mut emitters = Vec::new();
         let mut mesh_emitter = vec![None; scene.meshes.len()];
         let mut visibility = Vec::new();
+        let mut links = Vec::new();
         for (mi, m) in scene.meshes.iter().enumerate() {
             let program = &programs[m.material];
             // Placed meshes emit through their baked copies; a mesh emptied by the baking
@@ -455,6 +519,7 @@ impl LightParts {
             match AreaEmitter::with_program(scene, mi, program.clone()) {
                 Some(e) => {
                     mesh_emitter[mi] = Some(emitters.len() as u32);
+                    links.push(m.attrs.object.links);
                     emitters.push(EmitterInstance::Area(
                         e.with_camera(camera_to_world, window.clone()),
                     ));
@@ -474,7 +539,8 @@ impl LightParts {
                 )),
             }
         }
-        for l in &scene.lights {
+        for (li, l) in scene.lights.iter().enumerate() {
+            links.push(scene.light_links.get(li).copied().unwrap_or_default());
             visibility.push(match l {
                 Light::Blender { visibility, .. } => *visibility,
                 _ => LightVisibility::default(),
@@ -554,6 +620,16 @@ impl LightParts {
             powers[b as usize] = 0.0;
             LightSampler::with_bounds(&powers, &bounds, radius, choice)
         });
+        // The world is never linked.
+        links.resize(emitters.len(), LightLinks::default());
+        let linking = Linking::new(
+            scene,
+            &links,
+            (&powers, &bounds),
+            constant_world,
+            radius,
+            choice,
+        );
         LightParts {
             emitter_accel,
             emitters,
@@ -565,6 +641,7 @@ impl LightParts {
             suns,
             lights,
             mis_lights,
+            linking,
         }
     }
 }
@@ -646,6 +723,7 @@ impl RenderScene {
             mis_lights: parts.mis_lights,
             radius,
             choice,
+            linking: parts.linking,
         };
         rs.camera_medium = rs.camera_medium();
         rs
@@ -693,6 +771,7 @@ impl RenderScene {
         self.suns = p.suns;
         self.lights = p.lights;
         self.mis_lights = p.mis_lights;
+        self.linking = p.linking;
     }
 
     /// Whether [`RenderScene::refresh_shading`] can take the scene's materials as they stand
@@ -836,7 +915,53 @@ impl RenderScene {
     /// rays can hit, with multiple importance sampling on).
     #[inline]
     pub fn light_uses_mis(&self, e: u32) -> bool {
-        !self.emitters[e as usize].is_delta() && self.visibility[e as usize].mis
+        !self.emitters[e as usize].is_delta()
+            && self.visibility[e as usize].mis
+            && self.blockers_of(e) == LightLinks::ALL
+    }
+
+    /// The receiver of light at `its`: the receiver set of its object plus one; 0 in scenes
+    /// without light linking (every light reaches it).
+    #[inline]
+    pub fn receiver_at(&self, its: &Intersection) -> u8 {
+        if self.linking.is_none() {
+            return 0;
+        }
+        let o = match self.scene.instances.get(its.instance as usize) {
+            Some(i) => &i.object,
+            None => &self.scene.meshes[its.mesh as usize].attrs.object,
+        };
+        o.links.receiver_set.saturating_add(1)
+    }
+
+    /// Whether emitter `e` lights `receiver` ([`Ctx::receiver`]).
+    #[inline]
+    pub fn lights_receiver(&self, e: u32, receiver: u8) -> bool {
+        match &self.linking {
+            Some(l) if receiver > 0 => l.lights[e as usize] >> (receiver - 1) & 1 != 0,
+            _ => true,
+        }
+    }
+
+    /// The blocker sets whose objects shadow emitter `e` ([`LightLinks::shadowed_by`]).
+    #[inline]
+    fn blockers_of(&self, e: u32) -> u64 {
+        self.linking
+            .as_ref()
+            .map_or(LightLinks::ALL, |l| l.shadowed_by[e as usize])
+    }
+
+    /// Whether the object of `hit` is in one of the blocker sets `blockers`.
+    #[inline]
+    fn blocks(&self, hit: &Hit, blockers: u64) -> bool {
+        if blockers == LightLinks::ALL {
+            return true;
+        }
+        let o = match self.scene.instances.get(hit.instance as usize) {
+            Some(i) => &i.object,
+            None => &self.scene.meshes[hit.key[0] as usize].attrs.object,
+        };
+        blockers >> o.links.blocker_set & 1 != 0
     }
 
     /// Whether any surface may let rays straight through (a transparent closure, or the
@@ -873,12 +998,15 @@ impl RenderScene {
         if !self.has_light_shapes() {
             return Vec3::ZERO;
         }
-        let flags = ctx.ray_flags;
+        let (flags, receiver) = (ctx.ray_flags, ctx.receiver);
         let mut hits = [(0u32, 0.0f32, Vec3::ZERO); 8];
         let mut n = 0;
         self.light_bvh.visit(o, d, tmax, |k| {
             let e = self.light_shapes[k as usize];
-            if n == hits.len() || !self.ray_sees(e, depth, flags) {
+            if n == hits.len()
+                || !self.ray_sees(e, depth, flags)
+                || !self.lights_receiver(e, receiver)
+            {
                 return;
             }
             let hit = match &self.emitters[e as usize] {
@@ -907,11 +1035,11 @@ impl RenderScene {
                 continue;
             }
             let tr = if occlusion {
-                self.segment_transmittance(ctx, o, d, t, Medium::default())
+                self.segment_transmittance(ctx, o, d, t, Medium::default(), self.blockers_of(e))
             } else {
                 Vec3::ONE
             };
-            sum += le * tr * self.forward_weight(e, &rec, bsdf_pdf, ctx.mis_from);
+            sum += le * tr * self.hit_weight(ctx, e, &rec, bsdf_pdf);
         }
         if tmax.is_infinite() {
             sum += self.suns_on_ray(ctx, o, d, depth, bsdf_pdf, occlusion);
@@ -934,7 +1062,7 @@ impl RenderScene {
         let flags = ctx.ray_flags;
         let mut sum = Vec3::ZERO;
         for &e in &self.suns {
-            if !self.ray_sees(e, depth, flags) {
+            if !self.ray_sees(e, depth, flags) || !self.lights_receiver(e, ctx.receiver) {
                 continue;
             }
             let rec = EmitterQueryRecord::towards(o, d);
@@ -943,38 +1071,33 @@ impl RenderScene {
                 continue;
             }
             let tr = if occlusion {
-                self.segment_transmittance(ctx, o, d, f32::INFINITY, Medium::default())
+                let blockers = self.blockers_of(e);
+                self.segment_transmittance(ctx, o, d, f32::INFINITY, Medium::default(), blockers)
             } else {
                 Vec3::ONE
             };
-            sum += le * tr * self.forward_weight(e, &rec, bsdf_pdf, ctx.mis_from);
+            sum += le * tr * self.hit_weight(ctx, e, &rec, bsdf_pdf);
         }
         sum
     }
 
-    /// MIS weight of light `e` met by a BSDF-sampled ray of density `bsdf_pdf` (sampled at
-    /// `from`, if given, else at the record's reference point).
+    /// MIS weight of light `e` met by the current ray, a BSDF sample of density `bsdf_pdf`
+    /// (infinite: weight 1) taken at [`Ctx::mis_from`] if given, else at the record's
+    /// reference point, for [`Ctx::receiver`]. A light with shadow linking is left to emitter
+    /// sampling (weight 0, its samples weight 1): the surface a BSDF-sampled ray stops at may
+    /// be one that does not shadow it.
     #[inline]
-    fn forward_weight(
-        &self,
-        e: u32,
-        rec: &EmitterQueryRecord,
-        bsdf_pdf: f32,
-        from: Option<Vec3>,
-    ) -> f32 {
+    pub fn hit_weight(&self, ctx: &Ctx, e: u32, rec: &EmitterQueryRecord, bsdf_pdf: f32) -> f32 {
         if bsdf_pdf.is_infinite() {
             1.0
+        } else if self.blockers_of(e) != LightLinks::ALL {
+            0.0
         } else {
-            mis_weight(bsdf_pdf, self.light_pdf_from(e, rec, from))
-        }
-    }
-
-    /// [`Self::light_pdf`] of the record as seen from `from` ([`Ctx::mis_from`]), if given.
-    #[inline]
-    pub fn light_pdf_from(&self, e: u32, rec: &EmitterQueryRecord, from: Option<Vec3>) -> f32 {
-        match from {
-            None => self.light_pdf(e, rec),
-            Some(o) => self.light_pdf(e, &rec.seen_from(o)),
+            let pdf = match ctx.mis_from {
+                None => self.light_pdf(e, rec, ctx.receiver),
+                Some(o) => self.light_pdf(e, &rec.seen_from(o), ctx.receiver),
+            };
+            mis_weight(bsdf_pdf, pdf)
         }
     }
 
@@ -986,7 +1109,7 @@ impl RenderScene {
             self.closest(ctx, o, d, f32::INFINITY)?
         } else {
             let kind = bounce_visibility(ctx.ray_flags);
-            self.closest_seen(ctx, o, d, f32::INFINITY, kind)?
+            self.closest_seen(ctx, o, d, f32::INFINITY, kind, LightLinks::ALL)?
         };
         Some(self.intersection(&hit, d))
     }
@@ -1024,14 +1147,23 @@ impl RenderScene {
         }
     }
 
-    /// [`Self::closest`] among the objects rays of the kinds `kind` see: the surfaces of
-    /// others are stepped over (up to [`MAX_HIDDEN_SKIPS`]; `t` stays measured from `o`).
+    /// [`Self::closest`] among the objects rays of the kinds `kind` see and of the blocker
+    /// sets `blockers`: the surfaces of others are stepped over (up to [`MAX_HIDDEN_SKIPS`];
+    /// `t` stays measured from `o`).
     #[inline(never)]
-    fn closest_seen(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32, kind: u32) -> Option<Hit> {
+    fn closest_seen(
+        &self,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        tmax: f32,
+        kind: u32,
+        blockers: u64,
+    ) -> Option<Hit> {
         let mut tmin = 0.0;
         for _ in 0..MAX_HIDDEN_SKIPS {
             let hit = self.closest_after(ctx, o, d, tmin, tmax)?;
-            if self.sees(&hit, kind) {
+            if self.sees(&hit, kind) && self.blocks(&hit, blockers) {
                 return Some(hit);
             }
             tmin = hit.t;
@@ -1039,13 +1171,20 @@ impl RenderScene {
         None
     }
 
-    /// The closest surface that casts shadows in `(0, tmax)`.
+    /// The closest surface that casts shadows in `(0, tmax)`, of the blocker sets `blockers`.
     #[inline]
-    fn closest_shadowing(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32) -> Option<Hit> {
-        if self.hides & ray::SHADOW == 0 {
+    fn closest_shadowing(
+        &self,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        tmax: f32,
+        blockers: u64,
+    ) -> Option<Hit> {
+        if self.hides & ray::SHADOW == 0 && blockers == LightLinks::ALL {
             self.closest(ctx, o, d, tmax)
         } else {
-            self.closest_seen(ctx, o, d, tmax, ray::SHADOW)
+            self.closest_seen(ctx, o, d, tmax, ray::SHADOW, blockers)
         }
     }
 
@@ -1167,12 +1306,14 @@ impl RenderScene {
         }
         let Some(emissive) = &self.emitter_accel else {
             let (path, flags) = (ctx.path_at(), ctx.ray_flags);
-            return self.emission_at(self.intersect(ctx, o, d).as_ref(), o, d, path, flags);
+            let receiver = ctx.receiver;
+            let hit = self.intersect(ctx, o, d);
+            return self.emission_at(hit.as_ref(), o, d, path, flags, receiver);
         };
         ctx.cast(o, d, f32::INFINITY, RayKind::Emission);
         if let Some(hit) = emissive.intersect_with(&mut ctx.trav, o, d, 0.0, f32::INFINITY) {
             let its = self.intersection(&hit, d);
-            let (e, le, rec) = self.emitted(&its, o, ctx.ray_flags, ctx.path_at())?;
+            let (e, le, rec) = self.emitted(&its, o, ctx.ray_flags, ctx.path_at(), ctx.receiver)?;
             if le == Vec3::ZERO {
                 return None;
             }
@@ -1204,7 +1345,8 @@ impl RenderScene {
                 tr *= medium::transmittance(m.sigma_t(), t);
             }
             let (e, le, rec) = match &hit {
-                Some(its) => match self.emitted(its, o, ctx.ray_flags, ctx.path_at()) {
+                Some(its) => match self.emitted(its, o, ctx.ray_flags, ctx.path_at(), ctx.receiver)
+                {
                     Some(x) => x,
                     None => (0, Vec3::ZERO, EmitterQueryRecord::default()),
                 },
@@ -1240,19 +1382,24 @@ impl RenderScene {
         program.transparency(&g, &self.shade_env(), &mut ctx.shade)
     }
 
-    /// The fraction of light from the emitter sample `rec` that reaches surface point `p`
-    /// (geometric normal `ng`): 1 or 0 for opaque scenes, the product of the transparent
-    /// surfaces' and the absorbing interiors' transmittance in between otherwise (starting
-    /// in `ctx.medium`).
+    /// The fraction of light from the sample `rec` of emitter `light` that reaches surface
+    /// point `p` (geometric normal `ng`): 1 or 0 for opaque scenes, the product of the
+    /// transparent surfaces' and the absorbing interiors' transmittance in between otherwise
+    /// (starting in `ctx.medium`). With shadow linking only the light's blockers stop it.
     #[inline]
     pub fn transmittance(
         &self,
         ctx: &mut Ctx,
         p: Vec3,
         ng: Vec3,
-        rec: &EmitterQueryRecord,
+        (light, rec): (u32, &EmitterQueryRecord),
     ) -> Vec3 {
-        if !self.passes && self.hides & ray::SHADOW == 0 && ctx.medium.is_clear() {
+        let blockers = self.blockers_of(light);
+        if !self.passes
+            && self.hides & ray::SHADOW == 0
+            && ctx.medium.is_clear()
+            && blockers == LightLinks::ALL
+        {
             return if self.unoccluded(ctx, p, ng, rec) {
                 Vec3::ONE
             } else {
@@ -1271,14 +1418,23 @@ impl RenderScene {
         } else {
             (rec.wi, f32::INFINITY)
         };
-        self.segment_transmittance(ctx, o, d, tmax, ctx.medium)
+        self.segment_transmittance(ctx, o, d, tmax, ctx.medium, blockers)
     }
 
     /// The transmittance of the segment `o + t d`, `t ∈ (0, tmax)`, which starts in medium
     /// `m`: 1 or 0 in opaque scenes, the product of the transparent surfaces' transmittance
-    /// and of the interiors' extinction ([`crate::medium`]) otherwise.
-    fn segment_transmittance(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32, m: Medium) -> Vec3 {
-        if !self.passes && self.hides & ray::SHADOW == 0 {
+    /// and of the interiors' extinction ([`crate::medium`]) otherwise; only objects of the
+    /// blocker sets `blockers` stop it.
+    fn segment_transmittance(
+        &self,
+        ctx: &mut Ctx,
+        o: Vec3,
+        d: Vec3,
+        tmax: f32,
+        m: Medium,
+        blockers: u64,
+    ) -> Vec3 {
+        if !self.passes && self.hides & ray::SHADOW == 0 && blockers == LightLinks::ALL {
             ctx.cast(o, d, tmax, RayKind::Any);
             return if self.occluded(ctx, o, d, tmax) {
                 Vec3::ZERO
@@ -1294,7 +1450,7 @@ impl RenderScene {
         let (mut tr, mut m) = (Vec3::ONE, m);
         for _ in 0..=MAX_TRANSPARENT {
             ctx.cast(o, d, tmax, RayKind::Closest);
-            let Some(hit) = self.closest_shadowing(ctx, o, d, tmax) else {
+            let Some(hit) = self.closest_shadowing(ctx, o, d, tmax, blockers) else {
                 return tr * medium::transmittance(m.sigma_t(), tmax);
             };
             let its = self.intersection(&hit, d);
@@ -1384,7 +1540,7 @@ impl RenderScene {
         let hit = if self.hides & ray::CAMERA == 0 {
             self.closest(ctx, o, d, tmax)
         } else {
-            self.closest_seen(ctx, o, d, tmax, ray::CAMERA)
+            self.closest_seen(ctx, o, d, tmax, ray::CAMERA, LightLinks::ALL)
         };
         let its = hit.map(|h| self.intersection(&h, d));
         if ctx.camera_memo {
@@ -1550,8 +1706,18 @@ impl RenderScene {
     /// Light Path bits `flags`, the hit being path vertex `path.0` after the bounces `path.1`,
     /// with the emitter's index for MIS.
     #[inline]
-    pub fn emitted(&self, its: &Intersection, from: Vec3, flags: u32, path: PathAt) -> Emitted {
+    pub fn emitted(
+        &self,
+        its: &Intersection,
+        from: Vec3,
+        flags: u32,
+        path: PathAt,
+        receiver: u8,
+    ) -> Emitted {
         let e = its.emitter?;
+        if !self.lights_receiver(e, receiver) {
+            return None;
+        }
         if flags & crate::shading::globals::ray::CAMERA != 0 && self.holdout_at(its) {
             return None;
         }
@@ -1575,9 +1741,10 @@ impl RenderScene {
         d: Vec3,
         (depth, depths): PathAt,
         flags: u32,
+        receiver: u8,
     ) -> Emitted {
         match hit {
-            Some(its) => self.emitted(its, o, flags, (depth, depths)),
+            Some(its) => self.emitted(its, o, flags, (depth, depths), receiver),
             None => self.background_radiance(d, o, depth, flags),
         }
     }
@@ -1665,15 +1832,24 @@ impl RenderScene {
     /// Light-selection probability times the emitter's solid-angle density of `rec` — the
     /// density of emitter sampling producing this direction, for MIS.
     #[inline]
-    pub fn light_pdf(&self, emitter: u32, rec: &EmitterQueryRecord) -> f32 {
-        self.light_choice(true).pmf_at(rec.ref_p, emitter as usize)
+    pub fn light_pdf(&self, emitter: u32, rec: &EmitterQueryRecord, receiver: u8) -> f32 {
+        self.light_choice(true, receiver)
+            .pmf_at(rec.ref_p, emitter as usize)
             * self.emitters[emitter as usize].pdf(&self.scene, rec)
     }
 
     /// The light choice of emitter sampling combined with BSDF sampling by MIS (`mis`), or on
-    /// its own.
+    /// its own, for `receiver` ([`Ctx::receiver`]: among the lights linked to it).
     #[inline]
-    pub fn light_choice(&self, mis: bool) -> &LightSampler {
+    pub fn light_choice(&self, mis: bool, receiver: u8) -> &LightSampler {
+        if let Some(l) = &self.linking
+            && let Some((lights, mis_lights)) = l.choices.get((receiver as usize).wrapping_sub(1))
+        {
+            return match mis_lights {
+                Some(m) if mis => m,
+                _ => lights,
+            };
+        }
         match &self.mis_lights {
             Some(l) if mis => l,
             _ => &self.lights,
@@ -1682,19 +1858,20 @@ impl RenderScene {
 
     /// Chooses an emitter and samples it from `ref_p`, the path being at the vertex and
     /// bounces `path` its emitter's shader sees ([`Ctx::light_sample_at`]); `mis`: the sample
-    /// is combined with BSDF sampling by MIS ([`Self::light_choice`]). Returns the record and
-    /// the weight `Le / (pmf · pdf)` (zero when no light could be sampled).
+    /// is combined with BSDF sampling by MIS ([`Self::light_choice`]), among the lights linked
+    /// to `receiver`. Returns the record and the weight `Le / (pmf · pdf)` (zero when no light
+    /// could be sampled).
     #[inline]
     pub fn sample_light(
         &self,
         ref_p: Vec3,
         (u_choice, u): (f32, Vec2),
         (depth, depths): PathAt,
-        mis: bool,
+        (mis, receiver): (bool, u8),
     ) -> (u32, EmitterQueryRecord, Vec3) {
         let mut rec = EmitterQueryRecord::from_ref(ref_p);
         (rec.depth, rec.depths) = (depth, depths);
-        let Some((i, pmf)) = self.light_choice(mis).sample_at(ref_p, u_choice) else {
+        let Some((i, pmf)) = self.light_choice(mis, receiver).sample_at(ref_p, u_choice) else {
             return (0, rec, Vec3::ZERO);
         };
         let w = self.emitters[i].sample(&self.scene, &mut rec, u);
@@ -1982,7 +2159,9 @@ mod tests {
             let its = rs
                 .intersect(&mut ctx, ref_p, rec.wi)
                 .expect("the ray hits the light");
-            let (_, hit, _) = rs.emitted(&its, ref_p, 0, (1, Default::default())).unwrap();
+            let (_, hit, _) = rs
+                .emitted(&its, ref_p, 0, (1, Default::default()), 0)
+                .unwrap();
             let backfacing = ng.dot(rec.wi) > 0.0;
             let expected = to_blender(-rec.wi).abs() * if backfacing { 2.0 } else { 1.0 };
             let tol = 1e-4 * expected.max_element();
@@ -2028,7 +2207,7 @@ mod tests {
                 let d = square_to_uniform_sphere(rng.next_2d());
                 let fast = rs.emission_along(&mut ctx, o, d);
                 let hit = rs.intersect(&mut ctx, o, d);
-                let full = rs.emission_at(hit.as_ref(), o, d, ctx.path_at(), ctx.ray_flags);
+                let full = rs.emission_at(hit.as_ref(), o, d, ctx.path_at(), ctx.ray_flags, 0);
                 let full = full.filter(|(_, le, _)| *le != Vec3::ZERO);
                 match (&fast, &full) {
                     (Some((a, la, ra)), Some((b, lb, rb))) => {

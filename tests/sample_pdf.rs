@@ -760,18 +760,18 @@ fn light_choice_is_folded_into_the_reported_pdf() {
         // Emitter sampling on its own, and combined with BSDF sampling by MIS (whose density
         // `light_pdf` reports).
         for mis in [false, true] {
-            let lights = rs.light_choice(mis);
+            let lights = rs.light_choice(mis, 0);
             let mut rng = Sampler::new(400, 0, 0);
             for _ in 0..20_000 {
                 let ref_p = v(4.0, 2.0, 4.0) * (rng.next_2d().extend(rng.next_1d()) - 0.5);
                 let u = (rng.next_1d(), rng.next_2d());
-                let (i, rec, w) = rs.sample_light(ref_p, u, (2, Default::default()), mis);
+                let (i, rec, w) = rs.sample_light(ref_p, u, (2, Default::default()), (mis, 0));
                 let e = &rs.emitters[i as usize];
                 let pmf = lights.pmf_at(ref_p, i as usize);
                 assert!(pmf > 0.0);
                 if rs.is_delta_light(i) {
                     assert_eq!(rec.pdf, 0.0);
-                    assert_eq!(rs.light_pdf(i, &rec), 0.0);
+                    assert_eq!(rs.light_pdf(i, &rec, 0), 0.0);
                     continue;
                 }
                 if w == Vec3::ZERO {
@@ -781,7 +781,7 @@ fn light_choice_is_folded_into_the_reported_pdf() {
                 assert!(close(rec.pdf, pmf * single, REL), "pmf·pdf");
                 if mis {
                     assert!(
-                        close(rs.light_pdf(i, &rebuilt(e, &rec)), rec.pdf, REL),
+                        close(rs.light_pdf(i, &rebuilt(e, &rec), 0), rec.pdf, REL),
                         "light_pdf"
                     );
                 }
@@ -803,14 +803,14 @@ fn a_constant_world_is_left_to_bsdf_sampling_under_mis() {
     // weight one), and the other lights share its probability.
     let rs = RenderScene::new(emitter_scene(), LightChoice::Power);
     let b = rs.background.expect("the scene has a background") as usize;
-    assert!(rs.light_choice(false).pmf(b) > 0.0);
-    assert_eq!(rs.light_choice(true).pmf(b), 0.0);
+    assert!(rs.light_choice(false, 0).pmf(b) > 0.0);
+    assert_eq!(rs.light_choice(true, 0).pmf(b), 0.0);
     let rec = EmitterQueryRecord::from_ref(Vec3::ZERO);
     let mut escaped = rec;
     escaped.wi = v(0.0, 0.0, 1.0);
-    assert_eq!(rs.light_pdf(b as u32, &escaped), 0.0);
+    assert_eq!(rs.light_pdf(b as u32, &escaped, 0), 0.0);
     let total: f32 = (0..rs.emitters.len())
-        .map(|i| rs.light_choice(true).pmf(i))
+        .map(|i| rs.light_choice(true, 0).pmf(i))
         .sum();
     assert!(close(total, 1.0, 1e-5), "{total}");
     let mut rng = Sampler::new(401, 0, 0);
@@ -818,7 +818,7 @@ fn a_constant_world_is_left_to_bsdf_sampling_under_mis() {
     for _ in 0..4000 {
         for (k, mis) in [false, true].into_iter().enumerate() {
             let u = (rng.next_1d(), rng.next_2d());
-            let (i, _, _) = rs.sample_light(Vec3::ZERO, u, (2, Default::default()), mis);
+            let (i, _, _) = rs.sample_light(Vec3::ZERO, u, (2, Default::default()), (mis, 0));
             chosen[k] += (i as usize == b) as u32;
         }
     }

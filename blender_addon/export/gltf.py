@@ -16,6 +16,7 @@ from .common import ExportCancelled, Phases, gltf_matrix, matrix
 from .images import ImageTable, Textures
 from .instances import collapse
 from .light import convert_light
+from .linking import LightLinking
 from .material import MaterialReport, default_surface, export_material
 from .mesh import (MESHLIKE, geometry_key, mesh_arrays, object_extras, read_mesh,
                    undeformed_positions)
@@ -233,6 +234,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
 
     skipped_types = set()
     hair_reported = set()
+    linking = LightLinking(depsgraph.objects)
     count = 0
     for inst in depsgraph.object_instances:
         count += 1
@@ -266,9 +268,6 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             cached = object_mesh(obj)
             if cached is None:
                 continue
-            if compat.light_linking_used(obj):
-                warnings.append("object '%s': light linking is not rendered; its emission "
-                                "lights and shadows every object" % obj.name)
             if getattr(obj, "is_shadow_catcher", False):
                 warnings.append("object '%s' is a shadow catcher; Tesela renders it as an "
                                 "ordinary object" % obj.name)
@@ -277,9 +276,14 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             extras = {"tesela_object": object_extras(inst, obj, depsgraph.view_layer)}
             if texspace is not None:
                 extras["tesela_texspace"] = {"location": texspace[0], "size": texspace[1]}
+            node = {"name": obj.name, "mesh": mi, "matrix": gltf_matrix(matrix(inst.matrix_world)),
+                    "extras": extras}
+            link = linking.extension(obj, inst.parent if inst.is_instance else None)
+            if link is not None:
+                node["extensions"] = {"TESELA_light_linking": link}
+                used_ext.add("TESELA_light_linking")
             mesh_nodes.setdefault(mi, []).append(len(doc["nodes"]))
-            add_node({"name": obj.name, "mesh": mi, "matrix": gltf_matrix(matrix(inst.matrix_world)),
-                      "extras": extras})
+            add_node(node)
         elif otype in ("CURVES", "POINTCLOUD", "VOLUME", "GPENCIL", "GREASEPENCIL"):
             if otype not in skipped_types:
                 skipped_types.add(otype)
@@ -291,9 +295,6 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             warnings.append("light '%s' is a portal: left out (Cycles uses portals only to "
                             "sample the world; Tesela samples it without them)" % obj.name)
         elif otype == "LIGHT":
-            if compat.light_linking_used(obj):
-                warnings.append("light '%s': light linking is not rendered; it lights and "
-                                "shadows every object" % obj.name)
             ext, khr = convert_light(obj.data, obj, matrix(inst.matrix_world), warnings,
                                      images)
             node = {"name": obj.name, "matrix": gltf_matrix(matrix(inst.matrix_world)),
@@ -304,6 +305,10 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                 khr_lights.append(khr)
                 node["extensions"]["KHR_lights_punctual"] = {"light": len(khr_lights) - 1}
                 used_ext.add("KHR_lights_punctual")
+            link = linking.extension(obj)
+            if link is not None:
+                node["extensions"]["TESELA_light_linking"] = link
+                used_ext.add("TESELA_light_linking")
             add_node(node)
 
     res.instanced_nodes = collapse(doc, root_nodes, buf, mesh_nodes, used_ext)

@@ -102,6 +102,7 @@ impl DataContext<'_> {
                     o,
                     crate::shading::globals::ray::CAMERA,
                     (1, Default::default()),
+                    0,
                 )
             {
                 if want_emission {

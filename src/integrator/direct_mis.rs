@@ -5,7 +5,7 @@
 
 use super::light_split::{ClassWeights, Sink, SplitsLight};
 use super::path::report;
-use super::{MAX_TRANSPARENT, ShadingPoint, mis_weight, sample_emitter_towards, spawn, trace_lit};
+use super::{MAX_TRANSPARENT, ShadingPoint, sample_emitter_towards, spawn, trace_lit};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
@@ -79,6 +79,7 @@ impl SplitsLight for DirectMis {
                 weights = sp.class_weights_sampled(&rec);
             }
             throughput *= w;
+            ctx.receiver = scene.receiver_at(&its);
             o = spawn(&its, wo);
             d = wo;
             depth += 1;
@@ -86,7 +87,7 @@ impl SplitsLight for DirectMis {
                 // The BSDF half of MIS at this vertex, then stop.
                 let (_, emitted, lights) = trace_lit(scene, ctx, o, d, depth, true, rec.pdf);
                 if let Some((e, le, erec)) = emitted {
-                    let c = throughput * le * mis_weight(rec.pdf, scene.light_pdf(e, &erec));
+                    let c = throughput * le * scene.hit_weight(ctx, e, &erec, rec.pdf);
                     l += c;
                     report(sink, c, depth, &weights);
                 }

@@ -957,7 +957,9 @@ pub fn sample_emitter_towards(
     let none = (Vec3::ZERO, Vec3::ZERO);
     // The light's choice and its point drawn jointly.
     let (u, uc) = ctx.sampler.next_3d();
-    let (light, rec, weight) = scene.sample_light(its.p, (uc, u), ctx.light_sample_at(), mis);
+    let receiver = scene.receiver_at(its);
+    let (light, rec, weight) =
+        scene.sample_light(its.p, (uc, u), ctx.light_sample_at(), (mis, receiver));
     if weight == Vec3::ZERO || !scene.light_reaches(light, sp.light_class()) {
         return none;
     }
@@ -971,7 +973,7 @@ pub fn sample_emitter_towards(
         return none;
     }
     let tr = if scene.casts_shadow(light) {
-        scene.transmittance(ctx, its.p, its.ng, &rec)
+        scene.transmittance(ctx, its.p, its.ng, (light, &rec))
     } else {
         Vec3::ONE
     };
@@ -1001,6 +1003,10 @@ pub fn trace_emitted(
     last: bool,
 ) -> (Option<Intersection>, Emitted) {
     ctx.depth = depth;
+    if depth <= 1 {
+        // Camera rays see every light.
+        ctx.receiver = 0;
+    }
     if last && depth > 1 {
         return (None, scene.emission_along(ctx, o, d));
     }
@@ -1010,7 +1016,7 @@ pub fn trace_emitted(
     } else {
         ctx.ray_flags
     };
-    let emitted = scene.emission_at(hit.as_ref(), o, d, ctx.path_at(), flags);
+    let emitted = scene.emission_at(hit.as_ref(), o, d, ctx.path_at(), flags, ctx.receiver);
     (hit, emitted)
 }
 

@@ -106,7 +106,8 @@ fn through_medium<S: Sink>(
 #[inline]
 fn sample_emitter_in_medium(scene: &RenderScene, ctx: &mut Ctx, p: Vec3, d: Vec3) -> Vec3 {
     let (u, uc) = ctx.sampler.next_3d();
-    let (light, rec, weight) = scene.sample_light(p, (uc, u), ctx.light_sample_at(), true);
+    // A point in a medium belongs to no object: every light reaches it.
+    let (light, rec, weight) = scene.sample_light(p, (uc, u), ctx.light_sample_at(), (true, 0));
     if weight == Vec3::ZERO {
         return Vec3::ZERO;
     }
@@ -115,7 +116,7 @@ fn sample_emitter_in_medium(scene: &RenderScene, ctx: &mut Ctx, p: Vec3, d: Vec3
         return Vec3::ZERO;
     }
     let tr = if scene.casts_shadow(light) {
-        scene.transmittance(ctx, p, Vec3::ZERO, &rec)
+        scene.transmittance(ctx, p, Vec3::ZERO, (light, &rec))
     } else {
         Vec3::ONE
     };
@@ -380,11 +381,7 @@ impl PathMis {
                 (&mut l, sink, &weights),
             );
             if let Some((e, le, erec)) = emitted {
-                let w = if bsdf_pdf.is_infinite() {
-                    1.0
-                } else {
-                    mis_weight(bsdf_pdf, scene.light_pdf_from(e, &erec, ctx.mis_from))
-                };
+                let w = scene.hit_weight(ctx, e, &erec, bsdf_pdf);
                 let c = self.paths.clamp(throughput * le * w, depth <= 2);
                 l += c;
                 report(sink, c, depth, &weights);
@@ -411,6 +408,7 @@ impl PathMis {
                 }
                 let (wo, pdf) = scatter_in_medium(ctx, d);
                 ctx.mis_from = None;
+                ctx.receiver = 0;
                 bsdf_pdf = pdf;
                 if counts.count(ctx.ray_flags, &self.paths) {
                     end = end.min(depth + 1);
@@ -498,6 +496,7 @@ impl PathMis {
                 weights = sp.class_weights_sampled(&rec);
             }
             ctx.mis_from = None;
+            ctx.receiver = scene.receiver_at(its);
             bsdf_pdf = if rec.measure == Measure::Discrete {
                 f32::INFINITY
             } else {

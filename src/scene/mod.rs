@@ -59,6 +59,37 @@ pub struct ObjectInfo {
     /// surfaces) see a hole in the film where they meet the object (alpha 0 with a
     /// transparent film, black with an opaque one); every other ray sees its material.
     pub holdout: bool,
+    /// Blender's light and shadow linking of the object, as receiver, blocker and emitter.
+    pub links: LightLinks,
+}
+
+/// Blender's light and shadow linking resolved into sets, as Cycles groups objects: objects
+/// with the same link states in every receiver collection form one receiver set (set 0: the
+/// objects no receiver collection names), likewise blocker sets; an emitter lights the
+/// receiver sets whose bit is in `lights`, and of the objects on a shadow ray towards it only
+/// those of a blocker set in `shadowed_by` block it. [`LightLinks::default`]: no linking.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightLinks {
+    pub receiver_set: u8,
+    pub blocker_set: u8,
+    pub lights: u64,
+    pub shadowed_by: u64,
+}
+
+impl LightLinks {
+    /// Every set.
+    pub const ALL: u64 = u64::MAX;
+}
+
+impl Default for LightLinks {
+    fn default() -> Self {
+        LightLinks {
+            receiver_set: 0,
+            blocker_set: 0,
+            lights: LightLinks::ALL,
+            shadowed_by: LightLinks::ALL,
+        }
+    }
 }
 
 impl ObjectInfo {
@@ -79,6 +110,7 @@ impl Default for ObjectInfo {
             location: Vec3::ZERO,
             visibility: ObjectInfo::VISIBLE_TO_ALL,
             holdout: false,
+            links: LightLinks::default(),
         }
     }
 }
@@ -816,6 +848,8 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     pub images: Vec<Image>,
     pub lights: Vec<Light>,
+    /// The light and shadow linking of each of `lights` (missing entries: none).
+    pub light_links: Vec<LightLinks>,
     pub camera: Option<Camera>,
     /// Constant background radiance seen by rays that leave the scene, W/(m² sr).
     pub background: Vec3,

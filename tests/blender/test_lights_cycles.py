@@ -394,10 +394,10 @@ def test_light_node_trees_are_read_or_reported(addon, tesela_bin, tmp_path):  # 
     assert "light 'Lamp'" in run.stderr and tex.name in run.stderr, run.stderr
 
 
-def test_portals_are_left_out_and_light_linking_and_motion_blur_reported(addon, tmp_path):  # noqa: F811
+def test_portals_are_left_out_motion_blur_reported_and_light_linking_exported(addon, tmp_path):  # noqa: F811
     """A Cycles portal only guides world sampling: it is not exported as a light (it would
-    emit), and says so; light linking and motion blur, which Tesela does not render, are
-    reported naming the light."""
+    emit), and says so; motion blur, which Tesela does not render, is reported; light linking
+    travels as TESELA_light_linking (the emitter names its collection, the member its state)."""
     import json
 
     from blender_addon import export
@@ -424,4 +424,8 @@ def test_portals_are_left_out_and_light_linking_and_motion_blur_reported(addon, 
     assert any("light 'Window' is a portal" in w for w in res.warnings), res.warnings
     assert any("motion blur is not rendered" in w for w in res.warnings), res.warnings
     if hasattr(lamp, "light_linking"):
-        assert any("light 'Lamp': light linking" in w for w in res.warnings), res.warnings
+        assert not any("light linking" in w for w in res.warnings), res.warnings
+        ext = {n["name"]: n.get("extensions", {}).get("TESELA_light_linking")
+               for n in doc["nodes"]}
+        assert ext["Lamp"] == {"receivers": 0}, ext
+        assert ext["Box"] == {"links": [[0, "INCLUDE"]]}, ext

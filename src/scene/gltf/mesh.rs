@@ -414,6 +414,7 @@ impl<'a> Loader<'a> {
     ) -> ObjectInfo {
         let mut info = ObjectInfo {
             location: world.w_axis.truncate(),
+            links: self.links_of(ni),
             ..Default::default()
         };
         let Some(o) = extras.and_then(|e| member(e, "tesela_object")) else {

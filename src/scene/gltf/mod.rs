@@ -19,6 +19,7 @@ mod draco;
 mod image_file;
 mod instances;
 mod lights;
+mod linking;
 mod material;
 mod mesh;
 mod meshopt;
@@ -78,6 +79,7 @@ const SUPPORTED_REQUIRED: &[&str] = &[
     "TESELA_material_graph",
     "TESELA_images",
     "TESELA_camera",
+    "TESELA_light_linking",
 ];
 
 /// Extensions that are used without a warning. Clearcoat, sheen and anisotropy reach the
@@ -109,6 +111,7 @@ const UNDERSTOOD: &[&str] = &[
     "TESELA_material_graph",
     "TESELA_images",
     "TESELA_camera",
+    "TESELA_light_linking",
 ];
 
 /// Loads a `.gltf` or `.glb` file. External files are resolved relative to its folder
@@ -260,8 +263,10 @@ fn load_parsed(
         vert_total: 0,
         origins: Origins::default(),
         options: *options,
+        links: HashMap::new(),
     };
     loader.root_extensions()?;
+    loader.light_linking();
     loader.walk()?;
     let mut origins = loader.origins;
     origins.mesh_node.resize(loader.scene.meshes.len(), None);
@@ -478,6 +483,8 @@ pub(crate) struct Loader<'a> {
     /// Which node made each mesh, instance and light.
     pub origins: Origins,
     pub options: LoadOptions,
+    /// Node → its light and shadow linking (`TESELA_light_linking`), for linked nodes.
+    pub links: HashMap<usize, crate::scene::LightLinks>,
 }
 
 /// `raw[key]` as an object member, if present.
@@ -648,6 +655,8 @@ impl<'a> Loader<'a> {
             let lights = self.scene.lights.len();
             self.node_lights(ni, world)?;
             (self.origins.light_node).resize(self.scene.lights.len().max(lights), ni);
+            let links = self.links_of(ni);
+            (self.scene.light_links).resize(self.scene.lights.len(), links);
             for c in node.children.iter().flatten().rev() {
                 stack.push((c.value(), world));
             }
