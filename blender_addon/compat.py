@@ -937,3 +937,9 @@ def blf_size(font, size):
         blf.size(font, size)
     else:
         blf.size(font, size, 72)
+
+
+def frame_final(scene):
+    """The scene's current frame with its subframe (what a particle's age is counted to)."""
+    final = getattr(scene, "frame_current_final", None)
+    return float(scene.frame_current if final is None else final)

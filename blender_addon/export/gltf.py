@@ -273,7 +273,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                                 "ordinary object" % obj.name)
             mi, ntri, texspace = cached
             res.triangles += ntri
-            extras = {"tesela_object": object_extras(inst, obj, depsgraph.view_layer)}
+            extras = {"tesela_object": object_extras(inst, obj, depsgraph.view_layer,
+                                                     compat.frame_final(depsgraph.scene))}
             if texspace is not None:
                 extras["tesela_texspace"] = {"location": texspace[0], "size": texspace[1]}
             node = {"name": obj.name, "mesh": mi, "matrix": gltf_matrix(matrix(inst.matrix_world)),

@@ -55,8 +55,11 @@ def collapse(doc, root_nodes, buf, mesh_nodes, used_ext, threshold=GPU_INSTANCIN
     drop = set()
     added = []
     for mi, idx in mesh_nodes.items():
-        # A linked object keeps its own node: an instancing node carries one set of links.
-        idx = [i for i in idx if "TESELA_light_linking" not in doc["nodes"][i].get("extensions", {})]
+        # A linked object keeps its own node: an instancing node carries one set of links;
+        # likewise a particle's instance, whose node carries its Particle Info.
+        idx = [i for i in idx
+               if "TESELA_light_linking" not in doc["nodes"][i].get("extensions", {})
+               and "particle" not in doc["nodes"][i].get("extras", {}).get("tesela_object", {})]
         if len(idx) <= threshold:
             continue
         cols = np.array([doc["nodes"][i]["matrix"] for i in idx], dtype=np.float64)

@@ -61,6 +61,24 @@ pub struct ObjectInfo {
     pub holdout: bool,
     /// Blender's light and shadow linking of the object, as receiver, blocker and emitter.
     pub links: LightLinks,
+    /// The particle an instance was placed by (Particle Info); `None` for other objects,
+    /// which read Cycles' all-zero particle.
+    pub particle: Option<Box<Particle>>,
+}
+
+/// One particle of a Blender particle system, as the Particle Info node reads it. Vectors in
+/// Blender's world coordinates, times in frames.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Particle {
+    /// The particle's index in its system.
+    pub index: u32,
+    /// Frames since its birth (the render frame minus its birth time).
+    pub age: f32,
+    pub lifetime: f32,
+    pub location: Vec3,
+    pub size: f32,
+    pub velocity: Vec3,
+    pub angular_velocity: Vec3,
 }
 
 /// Blender's light and shadow linking resolved into sets, as Cycles groups objects: objects
@@ -111,6 +129,7 @@ impl Default for ObjectInfo {
             visibility: ObjectInfo::VISIBLE_TO_ALL,
             holdout: false,
             links: LightLinks::default(),
+            particle: None,
         }
     }
 }

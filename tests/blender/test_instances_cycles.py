@@ -180,6 +180,87 @@ def test_hidden_particle_emitter_agrees_with_cycles(addon, tesela_bin, tmp_path,
     assert_agrees_with_cycles(particle_host_hidden(), "hidden particle emitter", 128, tmp_path)
 
 
+def particle_info(outputs, physics="NO"):
+    """A plane emitting 40 particles (all born at frame 1, random sizes and lifetimes) rendered
+    as small spheres, seen at frame 5 (age 4), over a lit floor; the spheres' Diffuse colour is
+    made of three Particle Info outputs, each scaled into [0, 1] (``outputs``: (output,
+    component or None, scale) per channel). The emitter itself is not rendered."""
+    scenes.clear_scene()
+    scene = bpy.context.scene
+    bpy.ops.mesh.primitive_plane_add(size=2.4, location=(0.0, 0.0, 0.25))
+    host = bpy.context.active_object
+    src = scenes.add_sphere("Src", (9.0, 9.0, 0.0), 1.0, None, segments=12, rings=6)
+    mat = bpy.data.materials.new("ByParticle")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    diffuse = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    nt.links.new(diffuse.outputs[0], out.inputs["Surface"])
+    info = nt.nodes.new("ShaderNodeParticleInfo")
+    combine = nt.nodes.new("ShaderNodeCombineXYZ")
+    for axis, (name, component, scale) in zip("XYZ", outputs):
+        value = info.outputs[name]
+        if component is not None:
+            sep = nt.nodes.new("ShaderNodeSeparateXYZ")
+            nt.links.new(value, sep.inputs[0])
+            value = sep.outputs[component]
+        mul = nt.nodes.new("ShaderNodeMath")
+        mul.operation = "MULTIPLY_ADD"
+        mul.use_clamp = True
+        mul.inputs[1].default_value = scale
+        mul.inputs[2].default_value = 0.5 if component is not None else 0.0
+        nt.links.new(value, mul.inputs[0])
+        nt.links.new(mul.outputs[0], combine.inputs[axis])
+    nt.links.new(combine.outputs[0], diffuse.inputs["Color"])
+    src.data.materials.append(mat)
+    ps = host.modifiers.new("P", "PARTICLE_SYSTEM").particle_system
+    ps.seed = 3
+    st = ps.settings
+    st.type = "EMITTER"
+    st.count = 40
+    st.frame_start = st.frame_end = 1
+    st.lifetime = 40
+    st.lifetime_random = 0.6
+    st.physics_type = physics
+    st.normal_factor = 0.6
+    st.effector_weights.gravity = 0.0
+    st.render_type = "OBJECT"
+    st.instance_object = src
+    st.particle_size = 0.1
+    st.size_random = 0.7
+    host.show_instancer_for_render = False
+    scenes.add_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)],
+                    scenes.lambert("F", (0.5, 0.5, 0.5)))
+    scenes.add_sun_light("Sun", (-0.3, 0.4, -1.0), 3.0)
+    scenes.add_camera((0.0, -3.2, 3.0), (0.0, 0.0, 0.3), fov=0.8)
+    scene.frame_start = 1
+    for frame in range(1, 6):
+        scene.frame_set(frame)
+    return scene
+
+
+PARTICLE_CASES = [
+    ("random_index_age", [("Random", None, 1.0), ("Index", None, 1 / 40), ("Age", None, 0.2)],
+     "NO"),
+    ("lifetime_size_location", [("Lifetime", None, 1 / 40), ("Size", None, 5.0),
+                                ("Location", "X", 0.4)], "NO"),
+    ("velocity", [("Velocity", "X", 1.0), ("Velocity", "Y", 1.0),
+                  ("Velocity", "Z", 0.8)], "NEWTON"),
+]
+
+
+@pytest.mark.parametrize("case", PARTICLE_CASES, ids=[c[0] for c in PARTICLE_CASES])
+def test_particle_info_agrees_with_cycles(addon, tesela_bin, tmp_path, monkeypatch, case):
+    """Particle Info on the instances of an emitter particle system: each sphere coloured by
+    its particle's index, random number, age, lifetime, size, location or velocity (the
+    previous renderer dropped the node: every sphere black or one colour)."""
+    name, outputs, physics = case
+    monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
+    assert_agrees_with_cycles(particle_info(outputs, physics), f"particle info {name}", 128,
+                              tmp_path)
+
+
 def curve_text_meta_surface():
     """A bevelled Bezier circle, a text, a metaball and a NURBS sphere: objects whose evaluated
     mesh the depsgraph yields as an instance row after the object's own (curve data) row."""

@@ -459,6 +459,13 @@ impl<'a> Loader<'a> {
             Some(Some(h)) => info.holdout = h,
             Some(None) => bad.push("holdout"),
         }
+        match member(o, "particle") {
+            None => {}
+            Some(p) => match particle(p) {
+                Some(p) => info.particle = Some(Box::new(p)),
+                None => bad.push("particle"),
+            },
+        }
         if !bad.is_empty() {
             self.warn_once(format!(
                 "node {ni}: extras.tesela_object has an invalid {}; defaults are used for it",
@@ -885,6 +892,40 @@ impl<'a> Loader<'a> {
 
 /// `extras.tesela_object.visibility` (`{"camera": bool, "shadow": bool, "diffuse": bool,
 /// "glossy": bool, "transmission": bool}`, a missing member is true) as
+/// `tesela_object.particle`: `{index, age, lifetime, location, size, velocity,
+/// angular_velocity}` (Blender's world coordinates, frames); every member optional, `None` if
+/// one is malformed.
+fn particle(v: &Value) -> Option<crate::scene::Particle> {
+    v.as_object()?;
+    let num = |k: &str| -> Option<f32> {
+        match member(v, k) {
+            None => Some(0.0),
+            Some(x) => x.as_f64().map(|x| x as f32).filter(|x| x.is_finite()),
+        }
+    };
+    let vec = |k: &str| -> Option<Vec3> {
+        match member(v, k) {
+            None => Some(Vec3::ZERO),
+            Some(x) => floats::<3>(Some(x))
+                .map(Vec3::from_array)
+                .filter(|v| v.is_finite()),
+        }
+    };
+    let index = match member(v, "index") {
+        None => 0,
+        Some(i) => u32::try_from(i.as_u64()?).ok()?,
+    };
+    Some(crate::scene::Particle {
+        index,
+        age: num("age")?,
+        lifetime: num("lifetime")?,
+        location: vec("location")?,
+        size: num("size")?,
+        velocity: vec("velocity")?,
+        angular_velocity: vec("angular_velocity")?,
+    })
+}
+
 /// [`ObjectInfo::visibility`] bits; None unless it is an object of booleans.
 fn visibility_bits(v: &Value) -> Option<u32> {
     use crate::shading::globals::ray;

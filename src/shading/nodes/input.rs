@@ -6,6 +6,20 @@ use crate::shading::globals::{ShadeEnv, ShaderGlobals, from_blender, ray, to_ble
 use crate::shading::program::{Op, Slot, Slots};
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
+/// The outputs of the Particle Info node.
+#[derive(Clone, Copy, Debug)]
+pub enum ParticleOut {
+    Index,
+    /// Cycles' `hash_uint2_to_float(index, 0)`.
+    Random,
+    Age,
+    Lifetime,
+    Location,
+    Size,
+    Velocity,
+    AngularVelocity,
+}
+
 /// Which value of the shading point an [`InputOp`] writes.
 #[derive(Clone, Debug)]
 pub enum Source {
@@ -34,6 +48,9 @@ pub enum Source {
     ObjectAlpha,
     ObjectIndex,
     ObjectRandom,
+    /// A Particle Info output of the point's particle (Cycles' all-zero particle for an
+    /// object no particle placed).
+    Particle(ParticleOut),
     /// Light Path flag bit.
     RayFlag(u32),
     RayDepth,
@@ -163,6 +180,23 @@ impl InputOp {
             Source::ObjectAlpha => s.set_f(self.out, info.map_or(1.0, |o| o.color.w)),
             Source::ObjectIndex => s.set_f(self.out, info.map_or(0.0, |o| o.pass_index)),
             Source::ObjectRandom => s.set_f(self.out, info.map_or(0.0, |o| o.random)),
+            Source::Particle(out) => {
+                let none = crate::scene::Particle::default();
+                let p = info.and_then(|o| o.particle.as_deref()).unwrap_or(&none);
+                match out {
+                    ParticleOut::Index => s.set_f(self.out, p.index as f32),
+                    ParticleOut::Random => s.set_f(
+                        self.out,
+                        crate::shading::tex::hash::hash_uint2_to_float(p.index, 0),
+                    ),
+                    ParticleOut::Age => s.set_f(self.out, p.age),
+                    ParticleOut::Lifetime => s.set_f(self.out, p.lifetime),
+                    ParticleOut::Location => s.set_v(self.out, p.location),
+                    ParticleOut::Size => s.set_f(self.out, p.size),
+                    ParticleOut::Velocity => s.set_v(self.out, p.velocity),
+                    ParticleOut::AngularVelocity => s.set_v(self.out, p.angular_velocity),
+                }
+            }
             Source::RayFlag(bit) => s.set_f(self.out, flag(g.ray_flags & bit != 0)),
             Source::RayDepth => s.set_f(self.out, g.ray_depth.saturating_sub(1) as f32),
             Source::KindDepth(kind) => {
@@ -328,6 +362,21 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             let index = cx.prop_f32("material_pass_index", 0.0);
             let index = cx.constant(&[index])?;
             cx.alias("Material Index", index, Float);
+        }
+        "ShaderNodeParticleInfo" => {
+            use ParticleOut as P;
+            for (id, ty, out) in [
+                ("Index", Float, P::Index),
+                ("Random", Float, P::Random),
+                ("Age", Float, P::Age),
+                ("Lifetime", Float, P::Lifetime),
+                ("Location", Vector, P::Location),
+                ("Size", Float, P::Size),
+                ("Velocity", Vector, P::Velocity),
+                ("Angular Velocity", Vector, P::AngularVelocity),
+            ] {
+                emit(cx, id, ty, Source::Particle(out))?;
+            }
         }
         "ShaderNodeLightPath" => {
             for (id, bit) in [
