@@ -10,6 +10,7 @@ import time
 import numpy as np
 
 from .. import compat
+from .attributes import InstanceAttributes, requested_names
 from .buffer import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT, UINT, Buffer
 from .camera import camera_extension, camera_fields, camera_matrix
 from .common import ExportCancelled, Phases, gltf_matrix, matrix
@@ -97,6 +98,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     mesh_cache = {}  # (geometry key, glTF materials) -> (mesh index, triangles, texspace)
     store_files = {}  # mesh store digest -> its first accessor here
     object_cache = {}  # (object name, data) -> the mesh_cache entry
+    attribute_names = {}  # object name -> the Attribute node names its materials read
+    instance_attributes = InstanceAttributes()
     mesh_nodes = {}  # glTF mesh index -> nodes placing it
     khr_lights = []
 
@@ -108,7 +111,8 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
         if mat is None:
             m = default_surface()
         else:
-            exported = export_material(mat, warnings, textures, images, report)
+            exported = export_material(mat, warnings, textures, images, report,
+                                       view_layer=depsgraph.view_layer)
             m, tangent_uvs = exported.gltf, exported.tangent_uvs
         for e in m.get("extensions", {}):
             used_ext.add(e)
@@ -273,8 +277,12 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                                 "ordinary object" % obj.name)
             mi, ntri, texspace = cached
             res.triangles += ntri
+            names = attribute_names.get(obj.name)
+            if names is None:
+                names = attribute_names[obj.name] = requested_names(obj)
             extras = {"tesela_object": object_extras(inst, obj, depsgraph.view_layer,
-                                                     compat.frame_final(depsgraph.scene))}
+                                                     compat.frame_final(depsgraph.scene),
+                                                     names, instance_attributes)}
             if texspace is not None:
                 extras["tesela_texspace"] = {"location": texspace[0], "size": texspace[1]}
             node = {"name": obj.name, "mesh": mi, "matrix": gltf_matrix(matrix(inst.matrix_world)),

@@ -48,6 +48,14 @@ def decompose(m):
     return t, q, s, ok
 
 
+def _collapsible(node):
+    """Whether a node's object data is shared by every placement of its mesh (all but the
+    random number and location, which the instancing node carries per instance)."""
+    obj = node.get("extras", {}).get("tesela_object", {})
+    return ("TESELA_light_linking" not in node.get("extensions", {})
+            and "particle" not in obj and "instancer" not in obj.get("attributes", {}))
+
+
 def collapse(doc, root_nodes, buf, mesh_nodes, used_ext, threshold=GPU_INSTANCING_MIN):
     """Replace the nodes of each mesh placed more than `threshold` times by one instancing
     node. `mesh_nodes`: glTF mesh index -> indices of the (root, childless) nodes placing it.
@@ -56,10 +64,8 @@ def collapse(doc, root_nodes, buf, mesh_nodes, used_ext, threshold=GPU_INSTANCIN
     added = []
     for mi, idx in mesh_nodes.items():
         # A linked object keeps its own node: an instancing node carries one set of links;
-        # likewise a particle's instance, whose node carries its Particle Info.
-        idx = [i for i in idx
-               if "TESELA_light_linking" not in doc["nodes"][i].get("extensions", {})
-               and "particle" not in doc["nodes"][i].get("extras", {}).get("tesela_object", {})]
+        # likewise an instance with a Particle Info or Instancer attributes of its own.
+        idx = [i for i in idx if _collapsible(doc["nodes"][i])]
         if len(idx) <= threshold:
             continue
         cols = np.array([doc["nodes"][i]["matrix"] for i in idx], dtype=np.float64)

@@ -12,6 +12,7 @@ import math
 import bpy
 
 from .. import compat
+from . import attributes
 from .common import color3, finite
 
 GRAPH_VERSION = 1
@@ -260,8 +261,9 @@ class MaterialReport:
 class MaterialGraph:
     """One material's node tree -> the TESELA_material_graph dict."""
 
-    def __init__(self, material, images, report):
+    def __init__(self, material, images, report, view_layer=None):
         self.material = material
+        self.view_layer = view_layer
         self.name = material.name
         self.images = images
         self.report = report
@@ -595,6 +597,13 @@ class MaterialGraph:
         if out is not None and hasattr(out, "default_value"):
             props["direction"] = self._floats(out.default_value, node, "direction")
 
+    def _props_attribute(self, node, props):
+        if getattr(node, "attribute_type", "GEOMETRY") == "VIEW_LAYER":
+            layer = self.view_layer or attributes.current_view_layer()
+            value = attributes.view_layer_value(layer, node.attribute_name)
+            if value is not None:
+                props["value"] = value
+
     def _props_object_info(self, node, props):
         # Object Info's Material Index is the material's Pass Index.
         props["material_pass_index"] = int(getattr(self.material, "pass_index", 0) or 0)
@@ -682,6 +691,7 @@ _SPECIAL_PROPS = {
     "ShaderNodeTexEnvironment": MaterialGraph._props_image,
     "ShaderNodeTexCoord": MaterialGraph._props_texcoord,
     "ShaderNodeObjectInfo": MaterialGraph._props_object_info,
+    "ShaderNodeAttribute": MaterialGraph._props_attribute,
     "ShaderNodeValToRGB": MaterialGraph._props_ramp,
     "ShaderNodeRGBCurve": MaterialGraph._props_curves,
     "ShaderNodeVectorCurve": MaterialGraph._props_curves,
@@ -700,10 +710,11 @@ class MaterialExport:
         self.tangent_uvs = tangent_uvs
 
 
-def export_material(material, warnings, textures, images, report):
+def export_material(material, warnings, textures, images, report, view_layer=None):
     """A Blender material -> MaterialExport: the metallic-roughness fallback with the
-    TESELA_material_graph extension beside it."""
-    graph = MaterialGraph(material, images, report)
+    TESELA_material_graph extension beside it (`view_layer`: where the Attribute node's View
+    Layer type looks its values up; the context's without one)."""
+    graph = MaterialGraph(material, images, report, view_layer)
     ext = graph.build()
     if getattr(material, "pass_index", 0):
         ext["pass_index"] = int(material.pass_index)  # the Material Index pass

@@ -12,6 +12,7 @@ import hashlib
 import numpy as np
 
 from .. import compat
+from .attributes import object_attributes
 from .common import ExportCancelled, Phases
 
 MESHLIKE = {"MESH", "CURVE", "SURFACE", "FONT", "META", "CURVES_LEGACY"}
@@ -721,11 +722,13 @@ def particle_extras(inst, obj, frame):
             "angular_velocity": [float(v) for v in pa.angular_velocity]}
 
 
-def object_extras(inst, obj, view_layer=None, frame=0.0):
+def object_extras(inst, obj, view_layer=None, frame=0.0, attribute_names=None,
+                  instance_attributes=None):
     """extras.tesela_object: what Object Info and Particle Info read (Blender's world
-    coordinates; `frame` is the render's frame, for a particle's age), the ray visibility
-    (Indirect Only clearing the camera's) and whether the object is a holdout (its own or its
-    instancer's)."""
+    coordinates; `frame` is the render's frame, for a particle's age), the values of the
+    Attribute node's Object and Instancer types its materials read (`attribute_names`, see
+    attributes.requested_names; `instance_attributes` an attributes.InstanceAttributes), the ray visibility (Indirect Only clearing the camera's) and
+    whether the object is a holdout (its own or its instancer's)."""
     rid = random_id(inst, obj)
     m = inst.matrix_world
     out = {"random": random_number(rid), "random_id": rid,
@@ -735,6 +738,10 @@ def object_extras(inst, obj, view_layer=None, frame=0.0):
     particle = particle_extras(inst, obj, frame)
     if particle is not None:
         out["particle"] = particle
+    if attribute_names is not None:
+        values = object_attributes(inst, obj, attribute_names, instance_attributes)
+        if values is not None:
+            out["attributes"] = values
     # An instance is hidden from the rays its object or its instancer is hidden from, and is
     # a holdout where either is.
     instancer = inst.parent if inst.is_instance else None

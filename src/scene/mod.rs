@@ -64,6 +64,30 @@ pub struct ObjectInfo {
     /// The particle an instance was placed by (Particle Info); `None` for other objects,
     /// which read Cycles' all-zero particle.
     pub particle: Option<Box<Particle>>,
+    /// The Attribute node's object and instancer attributes the object's materials read.
+    pub attributes: Option<Box<ObjectAttributes>>,
+}
+
+/// Values of the Attribute node's Object and Instancer types, as Cycles looks them up for
+/// one object (custom properties and property paths, as RGBA; a name not found reads zero).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ObjectAttributes {
+    /// Type Object: looked up on the object, then its data.
+    pub object: Vec<(String, glam::Vec4)>,
+    /// Type Instancer: looked up on an instance's particle settings and instancer first.
+    pub instancer: Vec<(String, glam::Vec4)>,
+}
+
+impl ObjectAttributes {
+    /// The value of `name` for the Object (`instancer` false) or Instancer type.
+    pub fn get(&self, name: &str, instancer: bool) -> Option<glam::Vec4> {
+        let list = if instancer {
+            &self.instancer
+        } else {
+            &self.object
+        };
+        list.iter().find(|(n, _)| n == name).map(|(_, v)| *v)
+    }
 }
 
 /// One particle of a Blender particle system, as the Particle Info node reads it. Vectors in
@@ -130,6 +154,7 @@ impl Default for ObjectInfo {
             holdout: false,
             links: LightLinks::default(),
             particle: None,
+            attributes: None,
         }
     }
 }

@@ -466,6 +466,13 @@ impl<'a> Loader<'a> {
                 None => bad.push("particle"),
             },
         }
+        match member(o, "attributes") {
+            None => {}
+            Some(a) => match object_attributes(a) {
+                Some(a) => info.attributes = Some(Box::new(a)),
+                None => bad.push("attributes"),
+            },
+        }
         if !bad.is_empty() {
             self.warn_once(format!(
                 "node {ni}: extras.tesela_object has an invalid {}; defaults are used for it",
@@ -923,6 +930,28 @@ fn particle(v: &Value) -> Option<crate::scene::Particle> {
         size: num("size")?,
         velocity: vec("velocity")?,
         angular_velocity: vec("angular_velocity")?,
+    })
+}
+
+/// `tesela_object.attributes`: `{"object": {name: [r, g, b, a]}, "instancer": {...}}` (both
+/// optional); `None` if malformed.
+fn object_attributes(v: &Value) -> Option<crate::scene::ObjectAttributes> {
+    v.as_object()?;
+    let list = |k: &str| -> Option<Vec<(String, glam::Vec4)>> {
+        let Some(m) = member(v, k) else {
+            return Some(Vec::new());
+        };
+        m.as_object()?
+            .iter()
+            .map(|(name, c)| {
+                let c = floats::<4>(Some(c)).map(glam::Vec4::from_array)?;
+                c.is_finite().then(|| (name.clone(), c))
+            })
+            .collect()
+    };
+    Some(crate::scene::ObjectAttributes {
+        object: list("object")?,
+        instancer: list("instancer")?,
     })
 }
 

@@ -61,6 +61,13 @@ pub enum Source {
     Color(String, bool),
     /// A geometry attribute by name: a UV map (Blender convention) or a colour attribute.
     Attribute(String, AttrPart),
+    /// The Attribute node's Object (`instancer` false) or Instancer type: the object's value
+    /// of that name (zero when it has none).
+    ObjectAttribute {
+        name: String,
+        instancer: bool,
+        part: AttrPart,
+    },
     /// Geometry > Random Per Island, from the face attribute [`ISLAND_ATTRIBUTE`].
     RandomPerIsland,
     /// Texture Coordinate > Window: the point's position in the camera frame.
@@ -92,6 +99,19 @@ pub enum AttrPart {
     /// Cycles' Fac: the mean of the three components.
     Average,
     Alpha,
+}
+
+impl AttrPart {
+    /// Writes this part of the RGBA value `v` to `out`.
+    #[inline]
+    fn write(self, s: &mut Slots, out: Slot, v: glam::Vec4) {
+        match self {
+            AttrPart::Rgb => s.set_v(out, v.truncate()),
+            AttrPart::First => s.set_f(out, v.x),
+            AttrPart::Average => s.set_f(out, (v.x + v.y + v.z) / 3.0),
+            AttrPart::Alpha => s.set_f(out, v.w),
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -236,12 +256,18 @@ impl InputOp {
                 } else {
                     g.color_attribute(name).unwrap_or(glam::Vec4::ZERO)
                 };
-                match part {
-                    AttrPart::Rgb => s.set_v(self.out, v.truncate()),
-                    AttrPart::First => s.set_f(self.out, v.x),
-                    AttrPart::Average => s.set_f(self.out, (v.x + v.y + v.z) / 3.0),
-                    AttrPart::Alpha => s.set_f(self.out, v.w),
-                }
+                part.write(s, self.out, v);
+            }
+            Source::ObjectAttribute {
+                name,
+                instancer,
+                part,
+            } => {
+                let v = info
+                    .and_then(|o| o.attributes.as_deref())
+                    .and_then(|a| a.get(name, *instancer))
+                    .unwrap_or(glam::Vec4::ZERO);
+                part.write(s, self.out, v);
             }
             Source::LayerWeight {
                 fresnel,
@@ -412,19 +438,54 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
         }
         "ShaderNodeAttribute" => {
             let name = cx.prop_str("attribute_name").unwrap_or("").to_string();
-            let ty = cx.prop_str("attribute_type").unwrap_or("GEOMETRY");
-            if ty != "GEOMETRY" {
-                cx.warn(
-                    "object/instancer/view-layer attributes are not supported; they read as zero",
-                );
+            let ty = cx
+                .prop_str("attribute_type")
+                .unwrap_or("GEOMETRY")
+                .to_string();
+            if ty == "VIEW_LAYER" {
+                // One value for the whole render, which the add-on resolves (view layer,
+                // scene, world); zero when none has it.
+                let v = cx
+                    .prop("value")
+                    .and_then(|v| v.as_array())
+                    .map(|a| {
+                        let mut c = [0.0f32; 4];
+                        for (o, x) in c.iter_mut().zip(a) {
+                            *o = x.as_f64().unwrap_or(0.0) as f32;
+                        }
+                        c
+                    })
+                    .filter(|c| c.iter().all(|x| x.is_finite()))
+                    .unwrap_or([0.0; 4]);
+                let rgb = cx.constant(&v[..3])?;
+                cx.alias("Color", rgb, Color);
+                cx.alias("Vector", rgb, Vector);
+                let fac = cx.constant(&[(v[0] + v[1] + v[2]) / 3.0])?;
+                cx.alias("Fac", fac, Float);
+                let alpha = cx.constant(&[v[3]])?;
+                cx.alias("Alpha", alpha, Float);
+                return Ok(true);
             }
+            let per_object = match ty.as_str() {
+                "OBJECT" => Some(false),
+                "INSTANCER" => Some(true),
+                _ => None,
+            };
             for (id, t, part) in [
                 ("Color", Color, AttrPart::Rgb),
                 ("Vector", Vector, AttrPart::Rgb),
                 ("Fac", Float, AttrPart::Average),
                 ("Alpha", Float, AttrPart::Alpha),
             ] {
-                emit(cx, id, t, Source::Attribute(name.clone(), part))?;
+                let src = match per_object {
+                    Some(instancer) => Source::ObjectAttribute {
+                        name: name.clone(),
+                        instancer,
+                        part,
+                    },
+                    None => Source::Attribute(name.clone(), part),
+                };
+                emit(cx, id, t, src)?;
             }
         }
         "ShaderNodeLayerWeight" => {
