@@ -14,6 +14,7 @@ from .attributes import InstanceAttributes, requested_names
 from .buffer import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT, UINT, Buffer
 from .camera import camera_extension, camera_fields, camera_matrix
 from .common import ExportCancelled, Phases, gltf_matrix, matrix
+from .curves import curves_extension
 from .images import ImageTable, Textures
 from .instances import collapse
 from .light import convert_light
@@ -293,7 +294,21 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                 used_ext.add("TESELA_light_linking")
             mesh_nodes.setdefault(mi, []).append(len(doc["nodes"]))
             add_node(node)
-        elif otype in ("CURVES", "POINTCLOUD", "VOLUME", "GPENCIL", "GREASEPENCIL"):
+        elif otype == "CURVES":
+            slots = [s.material for s in obj.material_slots] or list(obj.data.materials)
+            ext = curves_extension(obj.data, [None if m is None else mat_idx(m)[0] for m in slots],
+                                   buf)
+            if ext is not None:
+                names = attribute_names.get(obj.name)
+                if names is None:
+                    names = attribute_names[obj.name] = requested_names(obj)
+                extras = {"tesela_object": object_extras(inst, obj, depsgraph.view_layer,
+                                                         compat.frame_final(depsgraph.scene),
+                                                         names, instance_attributes)}
+                add_node({"name": obj.name, "matrix": gltf_matrix(matrix(inst.matrix_world)),
+                          "extensions": {"TESELA_curves": ext}, "extras": extras})
+                used_ext.add("TESELA_curves")
+        elif otype in ("POINTCLOUD", "VOLUME", "GPENCIL", "GREASEPENCIL"):
             if otype not in skipped_types:
                 skipped_types.add(otype)
                 warnings.append("%s objects are not supported; '%s' (and any others) left out"

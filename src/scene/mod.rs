@@ -7,6 +7,7 @@
 //! W/m² for irradiance, W/(m² sr) for radiance).
 
 pub mod builtin;
+pub mod curves;
 pub mod error;
 pub mod gltf;
 pub mod gltf_write;

@@ -184,6 +184,20 @@ pub(crate) fn auto_texspace(lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
 }
 
 /// `v` as `[f32; N]` of finite numbers.
+/// How a primitive is placed in the scene ([`Loader::push_world_mesh`]).
+pub(crate) struct PlacedPrim {
+    /// Names the primitive in messages.
+    pub what: String,
+    pub name: String,
+    pub material: usize,
+    /// Local to world.
+    pub world: Mat4,
+    /// World to object (Blender's object coordinates).
+    pub to_object: Mat4,
+    pub texspace: Option<(Vec3, Vec3)>,
+    pub object: ObjectInfo,
+}
+
 fn floats<const N: usize>(v: Option<&Value>) -> Option<[f32; N]> {
     let a = v?.as_array().filter(|a| a.len() == N)?;
     let mut out = [0.0; N];
@@ -325,65 +339,91 @@ impl<'a> Loader<'a> {
             .unwrap_or(Mat4::IDENTITY);
         let single = mesh.primitives.len() == 1;
         for (pi, local, material) in prims {
-            let (positions, normals, indices) = to_world(&local, world).ok_or_else(|| {
-                invalid(format!(
-                    "mesh {mi} primitive {pi} on node {ni}: positions are not finite in world space"
-                ))
-            })?;
-            if let Some((i, p)) = positions
-                .iter()
-                .enumerate()
-                .find(|(_, p)| p.abs().max_element() > crate::accel::MAX_COORD)
-            {
-                return Err(invalid(format!(
-                    "mesh {mi} primitive {pi} on node {ni}: vertex {i} at {p} in world space is farther than {:e} m from the origin (the renderer's coordinate limit)",
-                    crate::accel::MAX_COORD
-                )));
-            }
-            self.tri_total = self.tri_total.saturating_add(indices.len());
-            self.vert_total = self.vert_total.saturating_add(positions.len());
-            if self.tri_total > MAX_TRIANGLES || self.vert_total > MAX_VERTICES {
-                return Err(LoadError::new(
-                    LoadErrorKind::TooLarge,
-                    format!(
-                        "the scene exceeds the limit of {MAX_TRIANGLES} triangles / {MAX_VERTICES} vertices (at mesh {mi} on node {ni})"
-                    ),
-                ));
-            }
             let name = if single {
                 base_name.clone()
             } else {
                 format!("{base_name}.{pi}")
             };
-            let mut colors = local.colors.clone();
-            let orco = match colors
-                .iter()
-                .position(|(n, _)| n == crate::scene::ORCO_LAYER)
-            {
-                Some(i) => colors.remove(i).1.iter().map(|c| c.truncate()).collect(),
-                None => Vec::new(),
-            };
-            let attrs = MeshAttributes {
-                uv_names: local.uv_names.clone(),
-                extra_uvs: local.extra_uvs.clone(),
-                colors,
-                tangents: super::tangents::to_world(&local.tangents, world),
+            let placed = PlacedPrim {
+                what: format!("mesh {mi} primitive {pi} on node {ni}"),
+                name,
+                material,
+                world,
                 to_object,
                 texspace,
-                orco,
                 object: object.clone(),
             };
-            self.scene.meshes.push(Mesh {
-                name,
-                positions,
-                normals,
-                uvs: local.uvs.clone(),
-                indices,
-                material,
-                attrs,
-            });
+            self.push_world_mesh(&local, placed)?;
         }
         Ok((first..self.scene.meshes.len(), kept))
+    }
+
+    /// Adds primitive `local` to the scene as a world-space mesh placed as `placed` says,
+    /// counting it against the scene's limits.
+    pub(crate) fn push_world_mesh(
+        &mut self,
+        local: &LocalPrim,
+        placed: PlacedPrim,
+    ) -> Result<(), LoadError> {
+        let PlacedPrim {
+            what,
+            name,
+            material,
+            world,
+            to_object,
+            texspace,
+            object,
+        } = placed;
+        let (positions, normals, indices) = to_world(local, world)
+            .ok_or_else(|| invalid(format!("{what}: positions are not finite in world space")))?;
+        if let Some((i, p)) = positions
+            .iter()
+            .enumerate()
+            .find(|(_, p)| p.abs().max_element() > crate::accel::MAX_COORD)
+        {
+            return Err(invalid(format!(
+                "{what}: vertex {i} at {p} in world space is farther than {:e} m from the origin (the renderer's coordinate limit)",
+                crate::accel::MAX_COORD
+            )));
+        }
+        self.tri_total = self.tri_total.saturating_add(indices.len());
+        self.vert_total = self.vert_total.saturating_add(positions.len());
+        if self.tri_total > MAX_TRIANGLES || self.vert_total > MAX_VERTICES {
+            return Err(LoadError::new(
+                LoadErrorKind::TooLarge,
+                format!(
+                    "the scene exceeds the limit of {MAX_TRIANGLES} triangles / {MAX_VERTICES} vertices (at {what})"
+                ),
+            ));
+        }
+        let mut colors = local.colors.clone();
+        let orco = match colors
+            .iter()
+            .position(|(n, _)| n == crate::scene::ORCO_LAYER)
+        {
+            Some(i) => colors.remove(i).1.iter().map(|c| c.truncate()).collect(),
+            None => Vec::new(),
+        };
+        let attrs = MeshAttributes {
+            uv_names: local.uv_names.clone(),
+            extra_uvs: local.extra_uvs.clone(),
+            colors,
+            tangents: super::tangents::to_world(&local.tangents, world),
+            to_object,
+            texspace,
+            orco,
+            object,
+        };
+        self.scene.meshes.push(Mesh {
+            name,
+            positions,
+            normals,
+            uvs: local.uvs.clone(),
+            indices,
+            material,
+            attrs,
+        });
+        Ok(())
     }
 
     /// The scene material of a primitive that renders (triangles with positions), else `None`.

@@ -14,6 +14,7 @@
 mod accessor;
 mod camera;
 mod container;
+mod curves;
 mod document;
 mod draco;
 mod image_file;
@@ -55,6 +56,7 @@ const MAX_VERTICES: usize = 1 << 25;
 /// Extensions that may appear in `extensionsRequired`.
 const SUPPORTED_REQUIRED: &[&str] = &[
     "KHR_mesh_quantization",
+    "TESELA_curves",
     "KHR_draco_mesh_compression",
     "EXT_meshopt_compression",
     "KHR_meshopt_compression",
@@ -87,6 +89,7 @@ const SUPPORTED_REQUIRED: &[&str] = &[
 /// reports it. Volume attenuation, which is not rendered yet, is reported by the loader.
 const UNDERSTOOD: &[&str] = &[
     "KHR_mesh_quantization",
+    "TESELA_curves",
     "KHR_draco_mesh_compression",
     "EXT_meshopt_compression",
     "KHR_meshopt_compression",
@@ -650,6 +653,7 @@ impl<'a> Loader<'a> {
                     gpu_random,
                 });
             }
+            self.node_curves(ni, world)?;
             self.origins.node_world.resize(n, Mat4::IDENTITY);
             self.origins.node_world[ni] = world;
             let lights = self.scene.lights.len();

@@ -6,6 +6,19 @@ use crate::shading::globals::{ShadeEnv, ShaderGlobals, from_blender, ray, to_ble
 use crate::shading::program::{Op, Slot, Slots};
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
+/// The outputs of the Hair Info node that Tesela computes.
+#[derive(Clone, Copy, Debug)]
+pub enum HairOut {
+    IsStrand,
+    /// 0 at the root to 1 at the tip.
+    Intercept,
+    Length,
+    /// The strand's diameter at the point, in world units.
+    Thickness,
+    /// Cycles' `hash_uint2_to_float(curve, 0)`.
+    Random,
+}
+
 /// The outputs of the Particle Info node.
 #[derive(Clone, Copy, Debug)]
 pub enum ParticleOut {
@@ -48,6 +61,8 @@ pub enum Source {
     ObjectAlpha,
     ObjectIndex,
     ObjectRandom,
+    /// A Hair Info output of a point on a strand (zero elsewhere; Is Strand 0).
+    Hair(HairOut),
     /// A Particle Info output of the point's particle (Cycles' all-zero particle for an
     /// object no particle placed).
     Particle(ParticleOut),
@@ -200,6 +215,25 @@ impl InputOp {
             Source::ObjectAlpha => s.set_f(self.out, info.map_or(1.0, |o| o.color.w)),
             Source::ObjectIndex => s.set_f(self.out, info.map_or(0.0, |o| o.pass_index)),
             Source::ObjectRandom => s.set_f(self.out, info.map_or(0.0, |o| o.random)),
+            Source::Hair(out) => {
+                let info = g.color_attribute(crate::scene::curves::CURVE_LAYER);
+                let v = info.unwrap_or(glam::Vec4::ZERO);
+                let value = match out {
+                    HairOut::IsStrand => flag(info.is_some()),
+                    HairOut::Intercept => v.x,
+                    HairOut::Length => v.y,
+                    HairOut::Random => v.z,
+                    HairOut::Thickness => {
+                        // The object-space radius scaled to world units as Cycles scales it
+                        // (the length of the object's x axis in the world).
+                        let scale = g
+                            .to_object()
+                            .map_or(1.0, |m| 1.0 / m.x_axis.truncate().length().max(1e-12));
+                        2.0 * v.w * scale
+                    }
+                };
+                s.set_f(self.out, value);
+            }
             Source::Particle(out) => {
                 let none = crate::scene::Particle::default();
                 let p = info.and_then(|o| o.particle.as_deref()).unwrap_or(&none);
@@ -388,6 +422,19 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             let index = cx.prop_f32("material_pass_index", 0.0);
             let index = cx.constant(&[index])?;
             cx.alias("Material Index", index, Float);
+        }
+        "ShaderNodeHairInfo" => {
+            use HairOut as H;
+            for (id, out) in [
+                ("Is Strand", H::IsStrand),
+                ("Intercept", H::Intercept),
+                ("Length", H::Length),
+                ("Thickness", H::Thickness),
+                ("Random", H::Random),
+            ] {
+                emit(cx, id, Float, Source::Hair(out))?;
+            }
+            // Tangent Normal is not computed: the compiler reports it where it is used.
         }
         "ShaderNodeParticleInfo" => {
             use ParticleOut as P;
