@@ -4,13 +4,13 @@
 
 use crate::camera::RayCamera;
 use crate::film::accumulators::Accumulators;
-use crate::film::data::{self, DataContext};
-use crate::film::{Adaptive, PassSet, PixelAcc};
+use crate::film::data::DataContext;
+use crate::film::{Adaptive, Pass, PassSet, PixelAcc, catcher};
 use crate::integrator::light_split::LightSplit;
 use crate::integrator::{self, Integrator};
 use crate::render_scene::{Ctx, RayQuery, RenderScene};
 use crate::sampler::SobolSampler;
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -333,15 +333,16 @@ fn render_samples(
     let lens = camera.has_lens();
     let adaptive = opts.adaptive.is_some();
     let light = data.is_some_and(|d| d.passes.has_light());
-    // The film's data passes and coverage follow the integrator's camera ray.
-    ctx.camera_memo = data.is_some() || transparent;
+    let catcher = data.and_then(|d| d.passes.offset(Pass::CatcherSums));
+    let data = data.filter(|d| d.passes.iter().any(|(p, _)| p != Pass::CatcherSums));
+    // The film's data passes, coverage and catcher split follow the integrator's camera ray.
+    ctx.camera_memo = data.is_some() || transparent || catcher.is_some();
+    let sampler = |s: u32| match sampling {
+        Sampling::Sobol => SobolSampler::new(opts.seed, pixel_index, s as u64),
+        Sampling::Independent => SobolSampler::new(independent_seed(opts.seed, s), pixel_index, 0),
+    };
     for s in acc.next..end {
-        ctx.sampler = match sampling {
-            Sampling::Sobol => SobolSampler::new(opts.seed, pixel_index, s as u64),
-            Sampling::Independent => {
-                SobolSampler::new(independent_seed(opts.seed, s), pixel_index, 0)
-            }
-        };
+        ctx.sampler = sampler(s);
         // Dimension 0: the pixel filter (with the first BSDF sample reserved, see
         // `next_2d_reserving`); 1: the lens, only for cameras with depth of field.
         let u = ctx.sampler.next_2d_reserving();
@@ -369,8 +370,13 @@ fn render_samples(
         if l.is_finite() {
             acc.sum += l;
             acc.accepted += 1;
+            let coverage = if transparent {
+                scene.camera_coverage(ctx, ray.o, ray.d)
+            } else {
+                1.0
+            };
             if transparent {
-                acc.coverage += scene.camera_coverage(ctx, ray.o, ray.d);
+                acc.coverage += coverage;
             }
             if adaptive && crate::film::in_half_buffer(s) {
                 acc.half += 2.0 * l;
@@ -379,6 +385,38 @@ fn render_samples(
                 data.add_sample(ctx, ray.o, ray.d, acc.accepted == 1, aov);
                 if light {
                     data.add_light(&split, aov);
+                }
+            }
+            if let Some(at) = catcher {
+                let rec = &mut aov[at..at + Pass::CatcherSums.channels()];
+                match scene.trace(ctx, ray.o, ray.d, 1) {
+                    Some(its) if scene.catcher_at(&its) => {
+                        // The second path takes the first one's random numbers (Cycles copies
+                        // the path's state), so the two differ only where other objects are.
+                        ctx.sampler = sampler(s);
+                        ctx.sampler.next_2d_reserving();
+                        if lens {
+                            ctx.sampler.next_2d();
+                        }
+                        (ctx.catchers_only, ctx.camera_hit) = (true, None);
+                        let k = integrator.li(scene, ctx, ray.o, ray.d);
+                        (ctx.catchers_only, ctx.camera_hit) = (false, None);
+                        let k = if k.is_finite() { k } else { Vec3::ZERO };
+                        let world = if transparent {
+                            Vec3::ZERO
+                        } else {
+                            scene.world_radiance(ray.d, ray.o)
+                        };
+                        catcher::add_split(rec, k, world);
+                    }
+                    hit => {
+                        let world = if transparent || hit.is_some() {
+                            Vec3::ZERO
+                        } else {
+                            scene.world_radiance(ray.d, ray.o)
+                        };
+                        catcher::add_matte(rec, l, 1.0 - coverage, world);
+                    }
                 }
             }
         } else {
@@ -497,23 +535,19 @@ impl TileState {
     fn snapshot(&self, passes: &PassSet, acc: &PassSet, transparent: bool, spp: u32) -> Tile {
         let (stride, acc_stride) = (passes.stride(), acc.stride());
         let mut aovs = vec![0.0; self.px.len() * stride];
-        let noisy = passes.offset(crate::film::Pass::NoisyImage);
-        if stride > 0 {
-            for (i, p) in self.px.iter().enumerate() {
+        let pixels = (self.px.iter().enumerate())
+            .map(|(i, p)| {
                 let out = &mut aovs[i * stride..(i + 1) * stride];
-                let sums = &self.aov[i * acc_stride..(i + 1) * acc_stride];
-                data::resolve(acc, sums, p.accepted, passes, out);
-                if let Some(at) = noisy {
-                    out[at..at + 4].copy_from_slice(&p.rgba(transparent));
-                }
-            }
-        }
+                let rec = &self.aov[i * acc_stride..(i + 1) * acc_stride];
+                crate::film::resolve_pixel(p, acc, rec, passes, transparent, out)
+            })
+            .collect();
         Tile {
             x: self.x,
             y: self.y,
             w: self.w,
             h: self.h,
-            pixels: self.px.iter().map(|p| p.rgba(transparent)).collect(),
+            pixels,
             aovs,
             spp,
         }
@@ -623,7 +657,10 @@ impl Progressive {
         let prepared = prepare(scene, opts)?;
         let [_, _, rw, rh] = prepared.region;
         let ts = opts.tile_size.max(1);
-        let acc_passes = opts.passes.with_dividers();
+        let mut acc_passes = opts.passes.with_dividers();
+        if scene.has_catchers() {
+            acc_passes = acc_passes.with_catcher();
+        }
         let acc_stride = acc_passes.stride();
         let mut tiles = Vec::new();
         for ty in (0..rh).step_by(ts as usize) {

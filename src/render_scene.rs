@@ -233,6 +233,9 @@ pub struct Ctx {
     /// direction, length, hit)` (a camera segment's hit depends on nothing else while the
     /// scene stays as it is).
     pub camera_hit: Option<(Vec3, Vec3, f32, Option<Intersection>)>,
+    /// The path is a shadow catcher's second path ([`crate::film::catcher`]): every ray it
+    /// casts sees the shadow catchers alone, as Cycles' catcher-pass paths do.
+    pub catchers_only: bool,
 }
 
 /// A path vertex's index and the path's bounces of each kind before it: what an emitter's
@@ -275,6 +278,7 @@ impl Ctx {
             medium: Medium::default(),
             camera_memo: false,
             camera_hit: None,
+            catchers_only: false,
         }
     }
 
@@ -284,6 +288,13 @@ impl Ctx {
     pub fn camera_tmax(&self, o: Vec3, d: Vec3) -> f32 {
         self.camera_end
             .map_or(f32::INFINITY, |end| (end - o).dot(d).max(0.0))
+    }
+
+    /// The bit that the visibility queries of a catchers-only path
+    /// ([`Ctx::catchers_only`]) add to the ray kinds they ask for.
+    #[inline]
+    fn catcher_kind(&self) -> u32 {
+        if self.catchers_only { CATCHERS_ONLY } else { 0 }
     }
 
     /// Counts a ray and records it if recording.
@@ -314,6 +325,8 @@ pub struct RenderScene {
     hides: u32,
     /// Some object is a holdout ([`ObjectInfo::holdout`]).
     holdouts: bool,
+    /// Some object is a shadow catcher ([`ObjectInfo::shadow_catcher`]).
+    catchers: bool,
     /// The camera in Blender's coordinates, for the graph's Camera coordinates.
     camera_to_world: Mat4,
     /// The camera's Window coordinates (shared with the mesh emitters).
@@ -438,13 +451,28 @@ fn world_medium(scene: &Scene) -> Medium {
         .map_or(Medium::default(), |c| *c.program.medium())
 }
 
-/// The ray kinds some world-space mesh or instance is hidden from.
+/// A ray-kind bit beyond the Light Path bits: the query is a catchers-only path's
+/// ([`Ctx::catchers_only`]), which sees shadow catchers alone.
+const CATCHERS_ONLY: u32 = 1 << 31;
+
+/// The ray kinds some world-space mesh or instance is hidden from. With a shadow catcher in
+/// the scene, every kind: a catchers-only path's rays of any kind step over the other objects,
+/// so every query takes the filtering way.
 fn hidden_rays(scene: &Scene) -> u32 {
+    if any_catcher(scene) {
+        return ObjectInfo::VISIBLE_TO_ALL;
+    }
     let meshes = scene.meshes.iter().map(|m| m.attrs.object.visibility);
     let instances = scene.instances.iter().map(|i| i.object.visibility);
     meshes
         .chain(instances)
         .fold(0, |h, v| h | (ObjectInfo::VISIBLE_TO_ALL & !v))
+}
+
+/// Whether some world-space mesh or instance is a shadow catcher.
+fn any_catcher(scene: &Scene) -> bool {
+    scene.meshes.iter().any(|m| m.attrs.object.shadow_catcher)
+        || scene.instances.iter().any(|i| i.object.shadow_catcher)
 }
 
 /// Whether some world-space mesh or instance is a holdout.
@@ -697,6 +725,7 @@ impl RenderScene {
         let absorbs = programs.iter().any(|p| !p.medium().is_clear()) || !world_medium.is_clear();
         let hides = hidden_rays(&scene);
         let holdouts = any_holdout(&scene);
+        let catchers = any_catcher(&scene);
         let mut rs = RenderScene {
             window,
             scene,
@@ -706,6 +735,7 @@ impl RenderScene {
             world_medium,
             hides,
             holdouts,
+            catchers,
             programs,
             camera_to_world,
             accel,
@@ -808,6 +838,7 @@ impl RenderScene {
             self.programs.iter().any(|p| !p.medium().is_clear()) || !self.world_medium.is_clear();
         self.hides = hidden_rays(&self.scene);
         self.holdouts = any_holdout(&self.scene);
+        self.catchers = any_catcher(&self.scene);
         self.camera_medium = self.camera_medium();
         warnings.extend(self.refresh_lights());
         warnings
@@ -1108,7 +1139,7 @@ impl RenderScene {
         let hit = if !self.hides_from_bounces() {
             self.closest(ctx, o, d, f32::INFINITY)?
         } else {
-            let kind = bounce_visibility(ctx.ray_flags);
+            let kind = bounce_visibility(ctx.ray_flags) | ctx.catcher_kind();
             self.closest_seen(ctx, o, d, f32::INFINITY, kind, LightLinks::ALL)?
         };
         Some(self.intersection(&hit, d))
@@ -1121,10 +1152,32 @@ impl RenderScene {
         self.hides & !(ray::CAMERA | ray::SHADOW) != 0
     }
 
-    /// Whether rays of the kinds `kind` (Light Path bits) see the object of `hit`.
+    /// Whether rays of the kinds `kind` (Light Path bits, and [`CATCHERS_ONLY`] for a
+    /// catchers-only path) see the object of `hit`.
     #[inline]
     fn sees(&self, hit: &Hit, kind: u32) -> bool {
-        self.object_visibility(hit.key[0], hit.instance) & kind != 0
+        let o = self.object(hit.key[0], hit.instance);
+        o.visibility & kind != 0 && (kind & CATCHERS_ONLY == 0 || o.shadow_catcher)
+    }
+
+    /// Whether the camera's first hit `its` splits the path at a shadow catcher: a catcher
+    /// that is no holdout (Cycles holds a holdout catcher out).
+    #[inline]
+    pub fn catcher_at(&self, its: &Intersection) -> bool {
+        self.catchers
+            && match self.scene.instances.get(its.instance as usize) {
+                Some(i) => i.object.shadow_catcher && !i.object.holdout,
+                None => {
+                    let o = &self.scene.meshes[its.mesh as usize].attrs.object;
+                    o.shadow_catcher && !o.holdout
+                }
+            }
+    }
+
+    /// Whether some object is a shadow catcher.
+    #[inline]
+    pub fn has_catchers(&self) -> bool {
+        self.catchers
     }
 
     /// Whether the object `its` hit is a holdout ([`ObjectInfo::holdout`]).
@@ -1137,13 +1190,13 @@ impl RenderScene {
             }
     }
 
-    /// [`ObjectInfo::visibility`] of world-space mesh `mesh`, or of `instance` when it is one.
+    /// The [`ObjectInfo`] of world-space mesh `mesh`, or of `instance` when it is one.
     #[inline]
-    fn object_visibility(&self, mesh: u32, instance: u32) -> u32 {
+    fn object(&self, mesh: u32, instance: u32) -> &ObjectInfo {
         if instance == NO_INSTANCE {
-            self.scene.meshes[mesh as usize].attrs.object.visibility
+            &self.scene.meshes[mesh as usize].attrs.object
         } else {
-            self.scene.instances[instance as usize].object.visibility
+            &self.scene.instances[instance as usize].object
         }
     }
 
@@ -1184,7 +1237,8 @@ impl RenderScene {
         if self.hides & ray::SHADOW == 0 && blockers == LightLinks::ALL {
             self.closest(ctx, o, d, tmax)
         } else {
-            self.closest_seen(ctx, o, d, tmax, ray::SHADOW, blockers)
+            let kind = ray::SHADOW | ctx.catcher_kind();
+            self.closest_seen(ctx, o, d, tmax, kind, blockers)
         }
     }
 
@@ -1540,7 +1594,8 @@ impl RenderScene {
         let hit = if self.hides & ray::CAMERA == 0 {
             self.closest(ctx, o, d, tmax)
         } else {
-            self.closest_seen(ctx, o, d, tmax, ray::CAMERA, LightLinks::ALL)
+            let kind = ray::CAMERA | ctx.catcher_kind();
+            self.closest_seen(ctx, o, d, tmax, kind, LightLinks::ALL)
         };
         let its = hit.map(|h| self.intersection(&h, d));
         if ctx.camera_memo {

@@ -273,9 +273,6 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             cached = object_mesh(obj)
             if cached is None:
                 continue
-            if getattr(obj, "is_shadow_catcher", False):
-                warnings.append("object '%s' is a shadow catcher; Tesela renders it as an "
-                                "ordinary object" % obj.name)
             mi, ntri, texspace = cached
             res.triangles += ntri
             names = attribute_names.get(obj.name)

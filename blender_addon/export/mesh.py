@@ -728,7 +728,7 @@ def object_extras(inst, obj, view_layer=None, frame=0.0, attribute_names=None,
     coordinates; `frame` is the render's frame, for a particle's age), the values of the
     Attribute node's Object and Instancer types its materials read (`attribute_names`, see
     attributes.requested_names; `instance_attributes` an attributes.InstanceAttributes), the ray visibility (Indirect Only clearing the camera's) and
-    whether the object is a holdout (its own or its instancer's)."""
+    whether the object is a holdout or a shadow catcher (its own or its instancer's)."""
     rid = random_id(inst, obj)
     m = inst.matrix_world
     out = {"random": random_number(rid), "random_id": rid,
@@ -759,4 +759,6 @@ def object_extras(inst, obj, view_layer=None, frame=0.0, attribute_names=None,
         out["visibility"] = vis
     if holdout:
         out["holdout"] = True
+    if getattr(obj, "is_shadow_catcher", False) or getattr(instancer, "is_shadow_catcher", False):
+        out["shadow_catcher"] = True
     return out

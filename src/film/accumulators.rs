@@ -14,7 +14,6 @@
 //! the sample range and what render the part belongs to.
 
 use super::PixelAcc;
-use super::data;
 use super::pass::{Pass, PassSet};
 use crate::render::Image;
 use std::ops::Range;
@@ -49,25 +48,17 @@ impl Accumulators {
     pub fn resolve(&self) -> Image {
         let stride = self.passes.stride();
         let mut aovs = vec![0.0; self.aovs.len()];
-        let noisy = self.passes.offset(Pass::NoisyImage);
-        if stride > 0 {
-            for (i, p) in self.pixels.iter().enumerate() {
+        let pixels = (self.pixels.iter().enumerate())
+            .map(|(i, p)| {
                 let r = i * stride..(i + 1) * stride;
-                let out = &mut aovs[r.clone()];
-                data::resolve(&self.passes, &self.aovs[r], p.accepted, &self.passes, out);
-                if let Some(at) = noisy {
-                    out[at..at + 4].copy_from_slice(&p.rgba(self.transparent));
-                }
-            }
-        }
+                let (rec, out) = (&self.aovs[r.clone()], &mut aovs[r]);
+                super::resolve_pixel(p, &self.passes, rec, &self.passes, self.transparent, out)
+            })
+            .collect();
         Image {
             width: self.width,
             height: self.height,
-            pixels: self
-                .pixels
-                .iter()
-                .map(|p| p.rgba(self.transparent))
-                .collect(),
+            pixels,
             passes: self.passes.clone(),
             aovs,
         }
@@ -274,7 +265,7 @@ pub fn read(path: &Path) -> Result<Accumulators, String> {
     let passes = attr("tesela.passes")?
         .split(',')
         .filter(|n| !n.is_empty())
-        .map(|n| Pass::from_name(n).ok_or_else(|| bad(&format!("unknown pass `{n}`"))))
+        .map(|n| Pass::from_record_name(n).ok_or_else(|| bad(&format!("unknown pass `{n}`"))))
         .collect::<std::result::Result<Vec<_>, _>>()?;
     let passes = PassSet::new(passes);
     let (w, h) = (layer.size.width(), layer.size.height());

@@ -267,6 +267,10 @@ pub fn resolve(acc_set: &PassSet, acc: &[f32], n: u32, out_set: &PassSet, out: &
         let Some(at) = acc_set.offset(pass) else {
             continue;
         };
+        if matches!(pass, Pass::ShadowCatcher | Pass::CatcherSums) {
+            // Formed with Combined ([`super::resolve_pixel`]).
+            continue;
+        }
         if let Some((class, _)) = pass.light() {
             // Σ radiance / Σ colour: the sample counts cancel.
             let col = acc_set.offset(class.passes().2).map_or(Vec3::ZERO, rgb);

@@ -5,6 +5,7 @@
 //! thread count and any split into rounds (Combined is bit-identical to one long round).
 
 pub mod accumulators;
+pub mod catcher;
 pub mod color;
 pub mod data;
 pub mod filter;
@@ -130,6 +131,41 @@ impl PixelAcc {
         };
         difference / (1e-4 + normalize)
     }
+}
+
+/// Pixel `p`'s Combined RGBA, with the passes of `out_set` written to `out` from its record
+/// `rec` (laid out by `acc_set`, which holds `out_set`'s passes and what they are computed
+/// from). With shadow catchers (`acc_set` holds [`Pass::CatcherSums`]) Combined is the
+/// catchers' matte with their shadows ([`catcher`]).
+pub fn resolve_pixel(
+    p: &PixelAcc,
+    acc_set: &PassSet,
+    rec: &[f32],
+    out_set: &PassSet,
+    transparent: bool,
+    out: &mut [f32],
+) -> [f32; 4] {
+    if acc_set.is_empty() {
+        return p.rgba(transparent);
+    }
+    if !out_set.is_empty() {
+        data::resolve(acc_set, rec, p.accepted, out_set, out);
+    }
+    let (rgba, shadow) = match acc_set.offset(Pass::CatcherSums) {
+        Some(at) => {
+            let sums = &rec[at..at + Pass::CatcherSums.channels()];
+            let with_shadow = !out_set.contains(Pass::ShadowCatcher);
+            catcher::resolve(p, sums, transparent, with_shadow)
+        }
+        None => (p.rgba(transparent), Vec3::ONE),
+    };
+    if let Some(at) = out_set.offset(Pass::NoisyImage) {
+        out[at..at + 4].copy_from_slice(&rgba);
+    }
+    if let Some(at) = out_set.offset(Pass::ShadowCatcher) {
+        out[at..at + 3].copy_from_slice(&shadow.to_array());
+    }
+    rgba
 }
 
 /// Spreads "not converged" to the horizontal, then the vertical neighbours of every

@@ -51,6 +51,14 @@ pub enum Pass {
     TransmissionColor,
     /// Combined before denoising (Cycles registers it when the view layer is denoised).
     NoisyImage,
+    /// Cycles' Shadow Catcher pass: per channel, the light the shadow catchers receive with
+    /// the other objects over the light they receive without them (1 where no catcher is
+    /// seen), over white by the alpha of the film ([`crate::film::catcher`]).
+    ShadowCatcher,
+    /// The film's own sums for shadow catchers, never shown ([`crate::film::catcher`]): the
+    /// matte (RGB, transparency), the catchers' light without the other objects (RGB, the
+    /// samples that met a catcher) and the world behind them (RGB).
+    CatcherSums,
 }
 
 /// The light-pass classes of a camera path's first bounce, in Cycles' order.
@@ -87,7 +95,7 @@ impl LightClass {
 }
 
 impl Pass {
-    pub const ALL: [Pass; 21] = [
+    pub const ALL: [Pass; 22] = [
         Pass::Depth,
         Pass::Mist,
         Pass::Normal,
@@ -109,6 +117,7 @@ impl Pass {
         Pass::TransmissionIndirect,
         Pass::TransmissionColor,
         Pass::NoisyImage,
+        Pass::ShadowCatcher,
     ];
 
     /// The command line's name (`--passes depth,normal,...`).
@@ -135,6 +144,8 @@ impl Pass {
             Pass::TransmissionIndirect => "transmission_indirect",
             Pass::TransmissionColor => "transmission_color",
             Pass::NoisyImage => "noisy_image",
+            Pass::ShadowCatcher => "shadow_catcher",
+            Pass::CatcherSums => "catcher_sums",
         }
     }
 
@@ -162,6 +173,8 @@ impl Pass {
             Pass::TransmissionIndirect => "TransInd",
             Pass::TransmissionColor => "TransCol",
             Pass::NoisyImage => "Noisy Image",
+            Pass::ShadowCatcher => "Shadow Catcher",
+            Pass::CatcherSums => "Catcher Sums",
         }
     }
 
@@ -173,6 +186,8 @@ impl Pass {
             Pass::Normal | Pass::Position | Pass::DenoisingNormal => "XYZ",
             Pass::Uv => "UVA",
             Pass::NoisyImage => "RGBA",
+            // Unique letters for the accumulator files' channel names.
+            Pass::CatcherSums => "RGBTKLMNXYZ",
             _ => "RGB",
         }
     }
@@ -183,6 +198,11 @@ impl Pass {
 
     pub fn from_name(name: &str) -> Option<Pass> {
         Pass::ALL.into_iter().find(|p| p.name() == name)
+    }
+
+    /// [`Pass::from_name`], also for the film's own records (which no one asks to render).
+    pub fn from_record_name(name: &str) -> Option<Pass> {
+        Pass::from_name(name).or((name == Pass::CatcherSums.name()).then_some(Pass::CatcherSums))
     }
 
     /// The light class of a Direct or Indirect pass, and whether it is the direct one.
@@ -260,6 +280,11 @@ impl PassSet {
                 })
         };
         PassSet::new(Pass::ALL.into_iter().filter(|&p| need(p)))
+    }
+
+    /// This set plus the shadow catchers' sums ([`Pass::CatcherSums`]), last.
+    pub fn with_catcher(&self) -> PassSet {
+        PassSet::new(self.passes.iter().copied().chain([Pass::CatcherSums]))
     }
 
     /// True when any Direct or Indirect light pass is enabled.

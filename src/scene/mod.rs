@@ -60,6 +60,10 @@ pub struct ObjectInfo {
     /// surfaces) see a hole in the film where they meet the object (alpha 0 with a
     /// transparent film, black with an opaque one); every other ray sees its material.
     pub holdout: bool,
+    /// Blender's Object > Visibility > Shadow Catcher: where camera rays first meet it, the
+    /// film keeps only the shadows and reflections other objects cast on it
+    /// ([`crate::film::catcher`]); every other ray sees it as an ordinary object.
+    pub shadow_catcher: bool,
     /// Blender's light and shadow linking of the object, as receiver, blocker and emitter.
     pub links: LightLinks,
     /// The particle an instance was placed by (Particle Info); `None` for other objects,
@@ -153,6 +157,7 @@ impl Default for ObjectInfo {
             location: Vec3::ZERO,
             visibility: ObjectInfo::VISIBLE_TO_ALL,
             holdout: false,
+            shadow_catcher: false,
             links: LightLinks::default(),
             particle: None,
             attributes: None,

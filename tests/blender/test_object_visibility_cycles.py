@@ -105,7 +105,7 @@ def test_ray_visibility_agrees_with_cycles(addon, tesela_bin, tmp_path, monkeypa
 def test_ray_visibility_is_exported_and_instances_inherit_it(addon, tmp_path):  # noqa: F811
     """tesela_object.visibility lists the kinds an object is hidden from; an instance of a
     collection is hidden from what its instancer is hidden from, and visible objects carry
-    nothing. A shadow catcher (not rendered as one) is reported."""
+    nothing."""
     scenes.clear_scene()
     ball = scenes.add_sphere("Ball", (0, 0, 0), 0.5, segments=8, rings=4)
     ball.visible_glossy = False
@@ -120,13 +120,10 @@ def test_ray_visibility_is_exported_and_instances_inherit_it(addon, tmp_path):  
     empty.location = (0, 3, 0)
     empty.visible_shadow = False
     bpy.context.scene.collection.objects.link(empty)
-    plain = bpy.data.objects["Plain"]
-    plain.is_shadow_catcher = True
     scenes.add_camera((0, -6, 1), (0, 0, 0))
     path = tmp_path / "v.gltf"
     from blender_addon import export
     res = export.write_gltf(bpy.context.evaluated_depsgraph_get(), str(path), width=8, height=8)
-    assert any("'Plain' is a shadow catcher" in w for w in res.warnings), res.warnings
     doc = json.loads(path.read_text(encoding="utf-8"))
     vis = {}
     for n in doc["nodes"]:

@@ -513,6 +513,11 @@ impl<'a> Loader<'a> {
                 None => bad.push("attributes"),
             },
         }
+        match member(o, "shadow_catcher").map(|v| v.as_bool()) {
+            None => {}
+            Some(Some(c)) => info.shadow_catcher = c,
+            Some(None) => bad.push("shadow_catcher"),
+        }
         if !bad.is_empty() {
             self.warn_once(format!(
                 "node {ni}: extras.tesela_object has an invalid {}; defaults are used for it",

@@ -854,3 +854,23 @@ fn colour_variants_only_for_preset_materials() {
     let graph = json!({ "extensions": { "TESELA_material_graph": { "version": 1, "nodes": [] } } });
     assert_eq!(count(graph), (1, vec![false, false]));
 }
+
+#[test]
+fn object_shadow_catcher_from_the_extras() {
+    let s = load(&quad_doc(json!({}), json!({}), &[], json!({})));
+    assert!(!s.meshes[0].attrs.object.shadow_catcher);
+    let node = json!({ "extras": { "tesela_object": { "shadow_catcher": true } } });
+    let s = load(&quad_doc(json!({}), json!({}), &[], node));
+    assert!(s.meshes[0].attrs.object.shadow_catcher);
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let node = json!({ "extras": { "tesela_object": { "shadow_catcher": 1 } } });
+    let s = load(&quad_doc(json!({}), json!({}), &[], node));
+    assert!(!s.meshes[0].attrs.object.shadow_catcher);
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains("invalid shadow_catcher")),
+        "{:?}",
+        s.warnings
+    );
+}
