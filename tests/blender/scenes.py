@@ -82,12 +82,17 @@ def clear_scene():
     The world is replaced rather than edited: a test that changed its settings (sampling
     method, ray visibility, ...) must not change the renders of the tests after it."""
     scene = bpy.context.scene
-    for ob in list(scene.objects):
+    # Every object, also those only in collections the scene instances (not linked to it),
+    # whose names a later test would otherwise find taken.
+    for ob in list(bpy.data.objects):
         bpy.data.objects.remove(ob, do_unlink=True)
+    for coll in list(bpy.data.collections):
+        bpy.data.collections.remove(coll)
     old_world, scene.world = scene.world, None
     if old_world is not None and old_world.users == 0:
         bpy.data.worlds.remove(old_world)
-    for coll in (bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras):
+    for coll in (bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras,
+                 getattr(bpy.data, "hair_curves", ())):
         for block in list(coll):
             if block.users == 0:
                 coll.remove(block)
