@@ -24,6 +24,10 @@ PASSES = (
     ("use_pass_transmission_indirect", "transmission_indirect", "TransInd", "RGB", "COLOR"),
     ("use_pass_transmission_color", "transmission_color", "TransCol", "RGB", "COLOR"),
 )
+# Passes whose toggles Cycles keeps in the view layer's Cycles settings (view_layer.cycles).
+CYCLES_PASSES = (
+    ("use_pass_shadow_catcher", "shadow_catcher", "Shadow Catcher", "RGB", "COLOR"),
+)
 # The Direct and Indirect light passes: only the integrators that split their light have them.
 LIGHT = ("diffuse_direct", "diffuse_indirect", "glossy_direct", "glossy_indirect",
          "transmission_direct", "transmission_indirect")
@@ -72,6 +76,9 @@ def enabled(view_layer, settings):
     light = splits_light(settings)
     out = [(name, bname, ids, kind) for toggle, name, bname, ids, kind in PASSES
            if getattr(view_layer, toggle, False) and (light or name not in LIGHT)]
+    cycles = getattr(view_layer, "cycles", None)
+    out += [(name, bname, ids, kind) for toggle, name, bname, ids, kind in CYCLES_PASSES
+            if getattr(cycles, toggle, False)]
     if denoised(view_layer, settings):
         out.append(NOISY)
     if store_denoising_data(view_layer, settings):

@@ -120,3 +120,47 @@ def test_shadow_catcher_is_exported(addon, tmp_path):  # noqa: F811
     flags = {n["name"]: n.get("extras", {}).get("tesela_object", {}).get("shadow_catcher")
              for n in doc["nodes"] if "mesh" in n}
     assert flags == {"Floor": True, "Box": None}, flags
+
+
+def test_shadow_catcher_pass_agrees_with_cycles(addon, tesela_bin, tmp_path, monkeypatch):
+    """View Layer > Passes > Shadow Catcher (view_layer.cycles.use_pass_shadow_catcher): the
+    pass (the shadow over white) and Combined, which becomes the matte alone (the box over
+    transparency), both as Cycles writes them."""
+    from test_passes_cycles import pass_of
+
+    def render_multilayer(path):
+        import OpenEXR
+        settings = scene.render.image_settings
+        if hasattr(settings, "media_type"):
+            settings.media_type = "MULTI_LAYER_IMAGE"
+        settings.file_format = "OPEN_EXR_MULTILAYER"
+        settings.color_depth = "32"
+        scene.render.use_file_extension = False
+        scene.render.filepath = str(path)
+        assert bpy.ops.render.render(write_still=True) == {"FINISHED"}
+        layers = {}
+        for part in OpenEXR.File(str(path)).parts:
+            for name, ch in part.channels.items():
+                px = np.asarray(ch.pixels, dtype=np.float32)
+                layers[name.split(".", 1)[1] if "." in name else name] = px.reshape(
+                    SIZE, SIZE, -1)
+        return layers
+
+    monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
+    scene = box_on_catcher(diffuse_floor)
+    scenes.configure_cycles(scene, SIZE, SIZE, 256, 4, seed=7)
+    scene.render.film_transparent = True
+    scene.view_layers[0].cycles.use_pass_shadow_catcher = True
+    ref = render_multilayer(tmp_path / "cycles.exr")
+    scene.render.engine = "TESELA"
+    t = scene.tesela
+    scenes.tesela_like_cycles(t)
+    t.integrator, t.samples, t.max_depth, t.seed = "path_mis", 256, 6, 1
+    got = render_multilayer(tmp_path / "tesela.exr")
+    for name in ("Shadow Catcher", "Combined"):
+        r, g = pass_of(ref, name), pass_of(got, name)
+        rgb = imgcompare.compare(g[..., :3], r[..., :3], mean_tol=MEAN_TOL, block_tol=BLOCK_TOL)
+        print(f"{name}: {rgb}")
+        assert rgb.ok, f"{name}: Tesela (add-on) vs Cycles: {rgb}"
+    shadow = pass_of(ref, "Shadow Catcher")[..., :3].mean(axis=-1)
+    assert np.mean(shadow < 0.9) > 0.05, "the Cycles pass shows no shadow: the scene is broken"
