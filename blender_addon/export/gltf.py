@@ -14,7 +14,7 @@ from .attributes import InstanceAttributes, requested_names
 from .buffer import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT, UINT, Buffer
 from .camera import camera_extension, camera_fields, camera_matrix
 from .common import ExportCancelled, Phases, gltf_matrix, matrix
-from .curves import curves_extension
+from .curves import curves_extension, particle_hair_extension
 from .images import ImageTable, Textures
 from .instances import collapse
 from .light import convert_light
@@ -260,9 +260,23 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             hair = _rendered_hair(obj)
             if hair:
                 hair_reported.add(obj.name)
-                warnings.append("object '%s': hair (particle system %s) is not rendered; its "
-                                "strands are left out" % (obj.name, ", ".join(
-                                    "'%s'" % h for h in hair)))
+                slots = [s.material for s in obj.material_slots]
+                mats = [None if m is None else mat_idx(m)[0] for m in slots]
+                to_object = np.linalg.inv(matrix(inst.matrix_world))
+                for psys in obj.particle_systems:
+                    if psys.name not in hair:
+                        continue
+                    ext = particle_hair_extension(obj, psys, to_object, mats, buf,
+                                                  depsgraph.mode == "RENDER")
+                    if ext is None:
+                        continue
+                    add_node({"name": "%s %s" % (obj.name, psys.name),
+                              "matrix": gltf_matrix(matrix(inst.matrix_world)),
+                              "extensions": {"TESELA_curves": ext},
+                              "extras": {"tesela_object": object_extras(
+                                  inst, obj, depsgraph.view_layer,
+                                  compat.frame_final(depsgraph.scene))}})
+                    used_ext.add("TESELA_curves")
         if otype in MESHLIKE and not compat.row_is_geometry(obj):
             continue
         if otype in MESHLIKE and not getattr(inst, "show_self", True):

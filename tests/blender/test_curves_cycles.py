@@ -79,6 +79,33 @@ def stage(build):
     return scene
 
 
+def particle_hair(children=False):
+    """A plane growing hair particles drawn as paths (Cycles renders them as strands): thick
+    parents, or thinner interpolated children with some roughness; radius from root 1 to
+    tip 0.3 (times the scale), its shape curved, the tip closed."""
+    bpy.ops.mesh.primitive_plane_add(size=2.0, location=(0.0, 0.2, 0.02))
+    host = bpy.context.active_object
+    host.data.materials.append(scenes.lambert("Skin", (0.3, 0.3, 0.3)))
+    host.data.materials.append(glossy())
+    ps = host.modifiers.new("Hair", "PARTICLE_SYSTEM").particle_system
+    ps.seed = 2
+    st = ps.settings
+    st.type = "HAIR"
+    st.count = 40
+    st.hair_length = 0.8
+    st.material = 2
+    st.root_radius, st.tip_radius, st.radius_scale, st.shape = 1.0, 0.3, 0.04, -0.3
+    st.use_close_tip = True
+    st.roughness_1 = 0.3
+    if children:
+        st.child_type = "INTERPOLATED"
+        st.child_percent = 4
+        st.rendered_child_count = 4
+        st.radius_scale = 0.015
+        st.roughness_endpoint = 0.2
+    return host
+
+
 def glossy():
     return scenes.material("Strand", (0.8, 0.25, 0.1), roughness=0.4)
 
@@ -88,6 +115,8 @@ CASES = [
     ("poly", stage(lambda: strands(12, 5, 0.04, glossy(), poly=True))),
     ("hair_info", stage(lambda: strands(12, 5, 0.04, hair_info_material()))),
     # Fur: many thin strands, no radius attribute (Cycles' default radius 0.005).
+    ("particle_hair", stage(lambda: particle_hair())),
+    ("particle_hair_children", stage(lambda: particle_hair(children=True))),
     ("fur_default_radius", stage(lambda: strands(400, 6, 0.0, glossy(), seed=4, spread=0.9,
                                                  height=0.5, radii=False))),
 ]

@@ -328,10 +328,12 @@ def test_fast_reads_match_the_item_by_item_api(clean):
     assert compat._read_in_place(me.vertices, nv, np.float32, 3, "normal") is None
 
 
-def test_hair_particle_systems_are_reported(tmp_path):
-    """Hair strands (a particle system drawn as paths) are not rendered: the export says so once,
-    naming the object and the system; the emitter itself is still exported, and a system
-    disabled for renders, or emitter particles, say nothing."""
+def test_hair_particle_systems_are_exported_as_curves(tmp_path):
+    """Hair strands (a particle system drawn as paths) are exported as TESELA_curves on a node
+    of their own, one strand per particle, without a warning; the emitter itself is still
+    exported, and a system disabled for renders, or emitter particles, add nothing."""
+    import json
+
     from blender_addon import export
 
     scenes.clear_scene()
@@ -347,7 +349,12 @@ def test_hair_particle_systems_are_reported(tmp_path):
     dust.modifiers.new("Dust", "PARTICLE_SYSTEM").particle_system.settings.type = "EMITTER"
     scenes.add_camera((0, -5, 0), (0, 0, 0))
     dg = bpy.context.evaluated_depsgraph_get()
-    res = export.write_gltf(dg, str(tmp_path / "h.gltf"), width=8, height=8)
-    about = [w for w in res.warnings if "hair" in w]
-    assert len(about) == 1 and "'Furry'" in about[0] and "'Fur'" in about[0], res.warnings
+    path = tmp_path / "h.gltf"
+    res = export.write_gltf(dg, str(path), width=8, height=8)
+    assert not [w for w in res.warnings if "hair" in w], res.warnings
+    doc = json.loads(path.read_text(encoding="utf-8"))
+    strands = [n for n in doc["nodes"] if "TESELA_curves" in n.get("extensions", {})]
+    assert [n["name"] for n in strands] == ["Furry Fur"]
+    offsets = doc["accessors"][strands[0]["extensions"]["TESELA_curves"]["offsets"]]
+    assert offsets["count"] == 51, "one strand per hair particle"
     assert res.triangles >= 3 * 24 * 10, "the emitters are still exported"
