@@ -3,8 +3,9 @@
 //! Cycles renders a curve as a round tube swept along it ("3D curves"): through its control
 //! points with a uniform Catmull-Rom spline (end points repeated), or along straight segments
 //! for poly curves, the radius interpolated the same way, the ends rounded. Tesela builds that
-//! surface from triangles: rings of [`SIDES`] vertices at [`STEPS`] points per segment, framed by
-//! parallel transport so the tube does not twist, closed by hemispherical caps. Normals point
+//! surface from triangles: rings of vertices at a few points per segment, framed by parallel
+//! transport so the tube does not twist, closed by hemispherical caps; [`Detail`] says how
+//! many, fine for a few strands and coarser for fur of hundreds of thousands. Normals point
 //! out of the tube (the swept circle's), tangents along the curve (Cycles' `dPdu`), and every
 //! vertex carries what Hair Info reads in [`CURVE_LAYER`].
 
@@ -15,16 +16,66 @@ use glam::{Vec3, Vec4};
 /// measures it), Length, Random (`hash_uint2_to_float(curve, 0)`) and the radius (object space).
 pub const CURVE_LAYER: &str = "tesela:curve";
 
-/// Vertices around the tube.
-pub const SIDES: usize = 8;
-/// Rings per Catmull-Rom segment (a poly segment is straight: one).
-pub const STEPS: usize = 4;
-/// Rings of each hemispherical end cap, besides its pole.
-const CAP_RINGS: usize = 2;
+/// How finely tubes are built.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Detail {
+    /// Vertices around the tube.
+    pub sides: usize,
+    /// Rings per Catmull-Rom segment (a poly segment is straight: one).
+    pub steps: usize,
+    /// Rings of each hemispherical end cap, besides its pole.
+    pub cap_rings: usize,
+}
+
+impl Detail {
+    /// From finest to coarsest.
+    const LEVELS: [Detail; 4] = [
+        Detail {
+            sides: 8,
+            steps: 4,
+            cap_rings: 2,
+        },
+        Detail {
+            sides: 6,
+            steps: 2,
+            cap_rings: 1,
+        },
+        Detail {
+            sides: 4,
+            steps: 2,
+            cap_rings: 1,
+        },
+        Detail {
+            sides: 3,
+            steps: 1,
+            cap_rings: 0,
+        },
+    ];
+
+    /// The finest detail whose triangles for `curves` strands of `segments` segments in all
+    /// stay within `budget` (the coarsest if none does).
+    pub fn within(curves: usize, segments: usize, linear: bool, budget: usize) -> Detail {
+        let tris = |d: &Detail| {
+            let steps = if linear { 1 } else { d.steps };
+            2 * d.sides * (segments * steps + curves * (2 * d.cap_rings + 1))
+        };
+        *Self::LEVELS
+            .iter()
+            .find(|d| tris(d) <= budget)
+            .unwrap_or(&Self::LEVELS[3])
+    }
+}
+
+impl Default for Detail {
+    fn default() -> Self {
+        Self::LEVELS[0]
+    }
+}
 
 /// Strands in one object space: each `(c, a, b)` of `curves` is curve number `c` (what its
-/// Random is made of) with points `a..b`.
+/// Random is made of) with points `a..b`, built at `detail`.
 pub struct Strands<'a> {
+    pub detail: Detail,
     pub points: &'a [Vec3],
     pub radii: &'a [f32],
     pub curves: &'a [(u32, u32, u32)],
@@ -35,6 +86,7 @@ pub struct Strands<'a> {
 /// A tube mesh in the strands' space.
 #[derive(Default)]
 pub struct Tubes {
+    detail: Detail,
     pub positions: Vec<Vec3>,
     pub normals: Vec<Vec3>,
     /// Unit curve direction, `w` = 1.
@@ -76,13 +128,14 @@ fn perpendicular(t: Vec3) -> Vec3 {
 }
 
 impl Tubes {
-    /// The [`SIDES`] vertices of `ring` around its centre, in the plane of `u` and `t × u`.
+    /// The `sides` vertices of `ring` around its centre, in the plane of `u` and `t × u`.
     fn ring(&mut self, ring: &Ring) -> u32 {
         let Ring { c, r, t, u, info } = *ring;
         let first = self.positions.len() as u32;
         let v = t.cross(u);
-        for k in 0..SIDES {
-            let a = std::f32::consts::TAU * k as f32 / SIDES as f32;
+        let sides = self.detail.sides;
+        for k in 0..sides {
+            let a = std::f32::consts::TAU * k as f32 / sides as f32;
             let n = u * a.cos() + v * a.sin();
             self.positions.push(c + r * n);
             self.normals.push(n);
@@ -94,8 +147,9 @@ impl Tubes {
 
     /// Triangles between two consecutive rings.
     fn band(&mut self, a: u32, b: u32) {
-        for k in 0..SIDES as u32 {
-            let k1 = (k + 1) % SIDES as u32;
+        let sides = self.detail.sides as u32;
+        for k in 0..sides {
+            let k1 = (k + 1) % sides;
             self.tris.push([a + k, a + k1, b + k1]);
             self.tris.push([a + k, b + k1, b + k]);
         }
@@ -106,12 +160,15 @@ impl Tubes {
         let Ring { c, r, t, u, info } = *ring;
         let at_tip = dir.dot(t) > 0.0;
         let mut prev = edge;
-        for i in 1..=CAP_RINGS {
-            let a = std::f32::consts::FRAC_PI_2 * i as f32 / (CAP_RINGS + 1) as f32;
+        let Detail {
+            sides, cap_rings, ..
+        } = self.detail;
+        for i in 1..=cap_rings {
+            let a = std::f32::consts::FRAC_PI_2 * i as f32 / (cap_rings + 1) as f32;
             let first = self.positions.len() as u32;
             let v = t.cross(u);
-            for k in 0..SIDES {
-                let b = std::f32::consts::TAU * k as f32 / SIDES as f32;
+            for k in 0..sides {
+                let b = std::f32::consts::TAU * k as f32 / sides as f32;
                 let n = (u * b.cos() + v * b.sin()) * a.cos() + dir * a.sin();
                 self.positions.push(c + r * n);
                 self.normals.push(n);
@@ -130,8 +187,9 @@ impl Tubes {
         self.normals.push(dir);
         self.tangents.push(t.extend(1.0));
         self.info.push(info);
-        for k in 0..SIDES as u32 {
-            let k1 = (k + 1) % SIDES as u32;
+        let sides = sides as u32;
+        for k in 0..sides {
+            let k1 = (k + 1) % sides;
             if at_tip {
                 self.tris.push([prev + k, prev + k1, pole]);
             } else {
@@ -145,7 +203,10 @@ impl Tubes {
 /// Malformed ranges (out of order or past the points) are skipped, as are strands with
 /// non-finite points; the caller validates and reports.
 pub fn tessellate(s: &Strands) -> Tubes {
-    let mut out = Tubes::default();
+    let mut out = Tubes {
+        detail: s.detail,
+        ..Default::default()
+    };
     for &(curve, a, b) in s.curves {
         let (a, b) = (a as usize, b as usize);
         if a >= b || b > s.points.len() || b > s.radii.len() || b - a < 2 {
@@ -174,7 +235,7 @@ pub fn tessellate(s: &Strands) -> Tubes {
             pts[i].extend(rad[i].max(0.0))
         };
         // Centre, radius, unit tangent and intercept of every ring along the curve.
-        let steps = if s.linear { 1 } else { STEPS };
+        let steps = if s.linear { 1 } else { s.detail.steps };
         let mut samples: Vec<(Vec3, f32, Vec3, f32)> = Vec::new();
         for seg in 0..pts.len() - 1 {
             let i = seg as isize;
@@ -252,6 +313,7 @@ mod tests {
             Vec3::new(0.5, 0.0, 2.0),
         ];
         tessellate(&Strands {
+            detail: Detail::default(),
             points: &points,
             radii: &[0.1, 0.1, 0.05],
             curves: &[(0, 0, 3)],
@@ -284,7 +346,7 @@ mod tests {
                 .filter(|d| (*d - 0.1).abs() < 1e-4)
                 .collect();
             assert!(
-                ring.len() >= SIDES,
+                ring.len() >= Detail::default().sides,
                 "linear {linear}: no ring at the control point"
             );
         }
@@ -305,10 +367,22 @@ mod tests {
         assert!(t.info.iter().all(|i| i.z == r));
     }
 
+    /// Fur of many strands is built coarser, within the budget where a level fits it.
+    #[test]
+    fn detail_follows_the_budget() {
+        assert_eq!(Detail::within(10, 40, false, 1 << 22), Detail::default());
+        let fur = Detail::within(200_000, 800_000, false, 1 << 23);
+        assert!(fur.sides < 8);
+        let s = fur.steps;
+        let tris = 2 * fur.sides * (800_000 * s + 200_000 * (2 * fur.cap_rings + 1));
+        assert!(tris <= 1 << 23, "{fur:?}: {tris}");
+    }
+
     #[test]
     fn malformed_strands_are_skipped() {
         let points = [Vec3::ZERO, Vec3::X, Vec3::new(f32::NAN, 0.0, 0.0)];
         let t = tessellate(&Strands {
+            detail: Detail::default(),
             points: &points,
             radii: &[0.1; 3],
             curves: &[(0, 0, 2), (1, 2, 1), (2, 1, 3), (3, 3, 9)],

@@ -17,13 +17,16 @@ use serde_json::Value;
 
 use super::mesh::PlacedPrim;
 use super::{LoadError, Loader, LocalPrim, extension, invalid, member};
-use crate::scene::curves::{CURVE_LAYER, Strands, tessellate};
+use crate::scene::curves::{CURVE_LAYER, Detail, Strands, tessellate};
 use ::gltf::json;
 
 pub(crate) const EXTENSION: &str = "TESELA_curves";
 
 /// Cycles' radius for curves without a radius attribute.
 const DEFAULT_RADIUS: f32 = 0.005;
+
+/// Triangles the tubes of one node may take: the finest detail that stays within it is used.
+const TRIANGLE_BUDGET: usize = 1 << 23;
 
 impl<'a> Loader<'a> {
     /// The strands of node `ni`, if it has any, as world-space tube meshes (one per material).
@@ -120,6 +123,11 @@ impl<'a> Loader<'a> {
         let to_object = Some(world.inverse())
             .filter(|m| m.is_finite())
             .unwrap_or(Mat4::IDENTITY);
+        let segments = offsets
+            .windows(2)
+            .map(|w| (w[1] - w[0]).saturating_sub(1) as usize)
+            .sum();
+        let detail = Detail::within(curves, segments, linear, TRIANGLE_BUDGET);
         let name = member(node, "name")
             .and_then(Value::as_str)
             .unwrap_or("curves")
@@ -133,6 +141,7 @@ impl<'a> Loader<'a> {
                 continue;
             }
             let tubes = tessellate(&Strands {
+                detail,
                 points: &points,
                 radii: &radii,
                 curves: &strands,
