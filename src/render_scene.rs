@@ -459,7 +459,7 @@ const CATCHERS_ONLY: u32 = 1 << 31;
 /// the scene, every kind: a catchers-only path's rays of any kind step over the other objects,
 /// so every query takes the filtering way.
 fn hidden_rays(scene: &Scene) -> u32 {
-    if any_catcher(scene) {
+    if any_catcher(scene) || any_strands(scene) {
         return ObjectInfo::VISIBLE_TO_ALL;
     }
     let meshes = scene.meshes.iter().map(|m| m.attrs.object.visibility);
@@ -467,6 +467,13 @@ fn hidden_rays(scene: &Scene) -> u32 {
     meshes
         .chain(instances)
         .fold(0, |h, v| h | (ObjectInfo::VISIBLE_TO_ALL & !v))
+}
+
+/// Whether some world-space mesh or instance is strands (their tubes' walls are seen from
+/// outside only, which takes the filtering way).
+fn any_strands(scene: &Scene) -> bool {
+    scene.meshes.iter().any(|m| m.attrs.object.strands)
+        || scene.instances.iter().any(|i| i.object.strands)
 }
 
 /// Whether some world-space mesh or instance is a shadow catcher.
@@ -1153,11 +1160,14 @@ impl RenderScene {
     }
 
     /// Whether rays of the kinds `kind` (Light Path bits, and [`CATCHERS_ONLY`] for a
-    /// catchers-only path) see the object of `hit`.
+    /// catchers-only path) along `d` see the object of `hit` (a strand's tube only from
+    /// outside).
     #[inline]
-    fn sees(&self, hit: &Hit, kind: u32) -> bool {
+    fn sees(&self, hit: &Hit, kind: u32, d: Vec3) -> bool {
         let o = self.object(hit.key[0], hit.instance);
-        o.visibility & kind != 0 && (kind & CATCHERS_ONLY == 0 || o.shadow_catcher)
+        o.visibility & kind != 0
+            && (kind & CATCHERS_ONLY == 0 || o.shadow_catcher)
+            && !(o.strands && hit.ng.dot(d) > 0.0)
     }
 
     /// Whether the camera's first hit `its` splits the path at a shadow catcher: a catcher
@@ -1216,7 +1226,7 @@ impl RenderScene {
         let mut tmin = 0.0;
         for _ in 0..MAX_HIDDEN_SKIPS {
             let hit = self.closest_after(ctx, o, d, tmin, tmax)?;
-            if self.sees(&hit, kind) && self.blocks(&hit, blockers) {
+            if self.sees(&hit, kind, d) && self.blocks(&hit, blockers) {
                 return Some(hit);
             }
             tmin = hit.t;
@@ -1754,6 +1764,7 @@ impl RenderScene {
                 | ClosureKind::Toon { color, .. }
                 | ClosureKind::Transparent { color } => color,
                 ClosureKind::Subsurface { .. } => Vec3::ONE,
+                ClosureKind::Hair(h) => h.hair_albedo(),
             }
     }
 

@@ -157,6 +157,11 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
             )
         }
         ClosureKind::Translucent { color } => BsdfInstance::Translucent(Translucent::new(*color)),
+        // The offset across the fibre is set with the shading point's frame.
+        ClosureKind::Hair(h) => {
+            let lobe = h.lobe(0.0);
+            BsdfInstance::ChiangHair(if blur > 0.0 { lobe.blurred(blur) } else { lobe })
+        }
         ClosureKind::Toon {
             color,
             size,

@@ -384,6 +384,12 @@ impl PrincipledHair {
         (r, rr, sigma)
     }
 
+    /// The fibre's albedo estimate seen across it (the colour passes and the denoiser's
+    /// albedo).
+    pub fn hair_albedo(&self) -> Vec3 {
+        self.lobe(0.0).albedo_estimate(Vec3::Z)
+    }
+
     /// The lobe at a hit with offset `h` across the fibre.
     pub fn lobe(&self, h: f32) -> ChiangHair {
         let (r, rr, sigma) = self.resolved();

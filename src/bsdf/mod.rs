@@ -129,6 +129,8 @@ pub enum BsdfInstance {
     Toon(Toon),
     Transparent(Transparent),
     Sheen(Sheen),
+    /// Principled Hair (Chiang) on a strand, in a frame whose +X is the strand.
+    ChiangHair(hair::ChiangHair),
     /// A coat or sheen over a base lobe ([`layered`]).
     Layered(Layered<TopLobe, BaseLobe>),
 }
@@ -146,6 +148,7 @@ macro_rules! dispatch {
             BsdfInstance::Toon($b) => $e,
             BsdfInstance::Transparent($b) => $e,
             BsdfInstance::Sheen($b) => $e,
+            BsdfInstance::ChiangHair($b) => $e,
             BsdfInstance::Layered($b) => $e,
         }
     };
@@ -184,7 +187,8 @@ impl BsdfInstance {
         match self {
             BsdfInstance::Dielectric(_)
             | BsdfInstance::Translucent(_)
-            | BsdfInstance::Transparent(_) => true,
+            | BsdfInstance::Transparent(_)
+            | BsdfInstance::ChiangHair(_) => true,
             BsdfInstance::RoughDielectric(d) => d.mode != DielectricMode::Reflection,
             BsdfInstance::Layered(l) => l.base.is_transmissive(),
             _ => false,

@@ -23,6 +23,8 @@ pub fn closure_colors(c: &Closure, mu: f32, backfacing: bool) -> [Vec3; 3] {
         ClosureKind::Diffuse { color, .. } | ClosureKind::Translucent { color } => {
             put(LightClass::Diffuse, color)
         }
+        // Cycles counts hair among its glossy closures; its albedo estimate across the fibre.
+        ClosureKind::Hair(h) => put(LightClass::Glossy, h.hair_albedo()),
         ClosureKind::Toon { color, glossy, .. } => {
             let class = if glossy {
                 LightClass::Glossy

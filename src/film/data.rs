@@ -39,6 +39,7 @@ fn closure_albedo(c: &Closure) -> Option<Vec3> {
         | ClosureKind::Translucent { color }
         | ClosureKind::Toon { color, .. } => color,
         ClosureKind::Subsurface { .. } => Vec3::ONE,
+        ClosureKind::Hair(h) => h.hair_albedo(),
         ClosureKind::Transparent { .. } => return None,
     };
     Some(c.weight * color)

@@ -216,6 +216,31 @@ impl ShadingPoint {
                 None => return false,
             }
         }
+        if let BsdfInstance::ChiangHair(hair) = &mut self.bsdf {
+            // A strand: local +X along it, the offset across it from the outward normal.
+            let n = its.ns;
+            let t = Some(closure.tangent)
+                .filter(|t| *t != Vec3::ZERO)
+                .unwrap_or_else(|| crate::frame::Frame::from_normal(n).s);
+            hair.h = bsdf::hair::offset_h(t, -d, n);
+            let across = (-d - t * t.dot(-d))
+                .try_normalize()
+                .unwrap_or_else(|| crate::frame::Frame::from_normal(t).s);
+            let frame = Frame {
+                s: t,
+                t: across.cross(t),
+                n: across,
+            };
+            self.smooth = None;
+            self.glossy_frame = None;
+            self.inner_frame = None;
+            self.passes = false;
+            self.wi = frame.to_local(-d);
+            self.frame = frame;
+            self.weight = closure.weight * (inv_p * share);
+            self.subsurface = None;
+            return true;
+        }
         let bsdf = &self.bsdf;
         // The closure's normal faces the viewer (Cycles' N); zero means the shading normal.
         let mut n = if closure.normal == Vec3::ZERO {
@@ -420,6 +445,7 @@ impl ShadingPoint {
             BsdfInstance::Toon(_) => ray::DIFFUSE,
             BsdfInstance::Transparent(_) => ray::TRANSMISSION,
             BsdfInstance::Sheen(_) => ray::DIFFUSE,
+            BsdfInstance::ChiangHair(_) => ray::GLOSSY | ray::TRANSMISSION,
             BsdfInstance::Layered(_) => ray::DIFFUSE | ray::GLOSSY | ray::TRANSMISSION,
         }
     }

@@ -64,6 +64,10 @@ pub struct ObjectInfo {
     /// film keeps only the shadows and reflections other objects cast on it
     /// ([`crate::film::catcher`]); every other ray sees it as an ordinary object.
     pub shadow_catcher: bool,
+    /// The object is strands built as closed tubes ([`crate::scene::curves`]): rays leaving
+    /// a tube pass through its wall, as Cycles' rays leave the curve they start on (light
+    /// through a fibre, shadow rays from it).
+    pub strands: bool,
     /// Blender's light and shadow linking of the object, as receiver, blocker and emitter.
     pub links: LightLinks,
     /// The particle an instance was placed by (Particle Info); `None` for other objects,
@@ -161,6 +165,7 @@ impl Default for ObjectInfo {
             links: LightLinks::default(),
             particle: None,
             attributes: None,
+            strands: false,
         }
     }
 }

@@ -135,6 +135,11 @@ pub enum ClosureKind {
         smooth: f32,
         glossy: bool,
     },
+    /// Blender's Principled Hair BSDF (Chiang model) on a strand: the closure's tangent is the
+    /// curve's direction (world space); the offset `h` across the fibre is found where the
+    /// shading point is set up, from the tangent, the normal and the viewer. Its Random input
+    /// is already resolved (the linked socket, else the strand's random number).
+    Hair(crate::bsdf::hair::PrincipledHair),
     /// Subsurface scattering (Blender's Subsurface Scattering node): a random walk below the
     /// surface; its colour is in the closure's weight, and also its albedo here.
     Subsurface {

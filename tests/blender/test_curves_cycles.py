@@ -106,6 +106,22 @@ def particle_hair(children=False):
     return host
 
 
+def principled_hair(parametrization="COLOR", **inputs):
+    """A Principled Hair BSDF (Chiang) with `parametrization` and the given inputs."""
+    mat = bpy.data.materials.new("Hair" + parametrization.title())
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    hair = nt.nodes.new("ShaderNodeBsdfHairPrincipled")
+    hair.model = "CHIANG"
+    hair.parametrization = parametrization
+    for name, value in inputs.items():
+        hair.inputs[name].default_value = value
+    nt.links.new(hair.outputs[0], out.inputs["Surface"])
+    return mat
+
+
 def glossy():
     return scenes.material("Strand", (0.8, 0.25, 0.1), roughness=0.4)
 
@@ -114,17 +130,29 @@ CASES = [
     ("catmull_rom", stage(lambda: strands(12, 5, 0.04, glossy()))),
     ("poly", stage(lambda: strands(12, 5, 0.04, glossy(), poly=True))),
     ("hair_info", stage(lambda: strands(12, 5, 0.04, hair_info_material()))),
-    # Fur: many thin strands, no radius attribute (Cycles' default radius 0.005).
+    # Known gap: Tesela's Principled Hair is 3.5% darker (direct colouring) and up to 2.7%
+    # bluer (melanin), block p95 0.12-0.13, not yet explained (the tilt is not the cause).
+    pytest.param("principled_hair_color", stage(lambda: strands(30, 6, 0.03, principled_hair(
+        "COLOR", Color=(0.6, 0.35, 0.2, 1.0), Roughness=0.25))),
+        marks=pytest.mark.xfail(reason="Principled Hair: 3.5% darker than Cycles")),
+    pytest.param("principled_hair_melanin", stage(lambda: strands(30, 6, 0.03, principled_hair(
+        "MELANIN", Melanin=0.4, **{"Melanin Redness": 0.6, "Random Color": 0.5,
+                                   "Random Roughness": 0.4, "Coat": 0.3}))),
+        marks=pytest.mark.xfail(reason="Principled Hair: up to 2.7% bluer than Cycles")),
+    ("principled_hair_absorption", stage(lambda: strands(30, 6, 0.03, principled_hair(
+        "ABSORPTION", **{"Absorption Coefficient": (0.3, 0.8, 2.0),
+                         "Radial Roughness": 0.6})))),
     ("particle_hair", stage(lambda: particle_hair())),
     ("particle_hair_children", stage(lambda: particle_hair(children=True))),
+    # Fur: many thin strands, no radius attribute (Cycles' default radius 0.005).
     ("fur_default_radius", stage(lambda: strands(400, 6, 0.0, glossy(), seed=4, spread=0.9,
                                                  height=0.5, radii=False))),
 ]
 
 
-@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
-def test_curves_agree_with_cycles(addon, tesela_bin, tmp_path, monkeypatch, case):
-    name, build = case
+@pytest.mark.parametrize("name, build", CASES, ids=[
+    c.values[0] if hasattr(c, "marks") else c[0] for c in CASES])
+def test_curves_agree_with_cycles(addon, tesela_bin, tmp_path, monkeypatch, name, build):
     monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
     scene = build()
     scenes.configure_cycles(scene, SIZE, SIZE, 256, 4, seed=7)

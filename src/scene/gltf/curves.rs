@@ -119,7 +119,8 @@ impl<'a> Loader<'a> {
             ));
         }
         let extras = member(node, "extras");
-        let object = self.object_info(ni, extras, world);
+        let mut object = self.object_info(ni, extras, world);
+        object.strands = true;
         let to_object = Some(world.inverse())
             .filter(|m| m.is_finite())
             .unwrap_or(Mat4::IDENTITY);

@@ -77,6 +77,18 @@ pub enum MetalFresnel {
 }
 
 /// A closure node's inputs.
+/// The inputs of a Principled Hair BSDF's colour parametrization.
+#[derive(Clone, Copy, Debug)]
+pub enum HairColorSlots {
+    Absorption(Slot),
+    Melanin {
+        melanin: Slot,
+        redness: Slot,
+        tint: Slot,
+    },
+    Reflectance(Slot),
+}
+
 #[derive(Clone, Debug)]
 pub enum ClosureParams {
     Principled(Box<PrincipledSlots>),
@@ -130,6 +142,21 @@ pub enum ClosureParams {
         smooth: Slot,
         normal: Option<Slot>,
         glossy: bool,
+    },
+    /// Principled Hair BSDF (Chiang); `color` holds the parametrization's inputs.
+    Hair {
+        color: HairColorSlots,
+        roughness: Slot,
+        radial_roughness: Slot,
+        coat: Slot,
+        ior: Slot,
+        offset: Slot,
+        random_color: Slot,
+        random_roughness: Slot,
+        /// The Random input, and whether it is linked (else the strand's own random number
+        /// is used where there is one, as in Cycles).
+        random: Slot,
+        random_linked: bool,
     },
     Transparent {
         color: Slot,
@@ -469,6 +496,54 @@ impl ClosureOp {
                     glossy: *glossy,
                 },
             ),
+            ClosureParams::Hair {
+                color,
+                roughness,
+                radial_roughness,
+                coat,
+                ior,
+                offset,
+                random_color,
+                random_roughness,
+                random,
+                random_linked,
+            } => {
+                use crate::bsdf::hair::{HairColor, PrincipledHair};
+                let strand = g.color_attribute(crate::scene::curves::CURVE_LAYER);
+                let random = match strand {
+                    Some(info) if !random_linked => info.z,
+                    _ => s.f(*random),
+                };
+                let color = match color {
+                    HairColorSlots::Absorption(a) => HairColor::Absorption(col(*a)),
+                    HairColorSlots::Melanin {
+                        melanin,
+                        redness,
+                        tint,
+                    } => HairColor::Melanin {
+                        melanin: s.f(*melanin).clamp(0.0, 1.0),
+                        redness: s.f(*redness).clamp(0.0, 1.0),
+                        tint: col(*tint),
+                    },
+                    HairColorSlots::Reflectance(c) => HairColor::Reflectance(col(*c)),
+                };
+                let hair = PrincipledHair {
+                    color,
+                    roughness: s.f(*roughness),
+                    radial_roughness: s.f(*radial_roughness),
+                    coat: s.f(*coat),
+                    ior: s.f(*ior),
+                    offset: s.f(*offset),
+                    random_color: s.f(*random_color),
+                    random_roughness: s.f(*random_roughness),
+                    random,
+                };
+                // The strand's direction (the curve tangent its mesh carries).
+                let t = g
+                    .tangent()
+                    .map_or(Vec3::ZERO, |(t, _)| from_blender(t).normalize_or_zero());
+                push(out, Vec3::splat(w), Vec3::ZERO, t, ClosureKind::Hair(hair));
+            }
             ClosureParams::Transparent { color } => push(
                 out,
                 col(*color) * w,
@@ -997,6 +1072,36 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
             normal: normal(cx, "Normal")?,
             glossy: cx.prop_str("component") == Some("GLOSSY"),
         },
+        "ShaderNodeBsdfHairPrincipled" => {
+            if cx.prop_str("model") == Some("HUANG") {
+                cx.warn("the Huang hair model is rendered with the Chiang model");
+            }
+            let color = match cx.prop_str("parametrization") {
+                Some("ABSORPTION") => HairColorSlots::Absorption(
+                    cx.color("Absorption Coefficient", Vec3::new(0.245531, 0.52, 1.365))?,
+                ),
+                Some("MELANIN") => HairColorSlots::Melanin {
+                    melanin: cx.float("Melanin", 0.8)?,
+                    redness: cx.float("Melanin Redness", 1.0)?,
+                    tint: cx.color("Tint", Vec3::ONE)?,
+                },
+                _ => HairColorSlots::Reflectance(
+                    cx.color("Color", Vec3::new(0.017513, 0.005763, 0.002059))?,
+                ),
+            };
+            ClosureParams::Hair {
+                color,
+                roughness: cx.float("Roughness", 0.3)?,
+                radial_roughness: cx.float("Radial Roughness", 0.3)?,
+                coat: cx.float("Coat", 0.0)?,
+                ior: cx.float("IOR", 1.55)?,
+                offset: cx.float("Offset", 2f32.to_radians())?,
+                random_color: cx.float("Random Color", 0.0)?,
+                random_roughness: cx.float("Random Roughness", 0.0)?,
+                random_linked: cx.is_linked("Random"),
+                random: cx.float("Random", 0.0)?,
+            }
+        }
         "ShaderNodeBsdfTranslucent" => ClosureParams::Translucent {
             color: cx.color("Color", Vec3::splat(0.8))?,
             normal: normal(cx, "Normal")?,
