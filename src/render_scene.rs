@@ -8,7 +8,7 @@ use crate::emitter::{
     AreaEmitter, Directional, Emitter, EmitterInstance, EmitterQueryRecord, LightChoice,
     LightSampler, PointLight, SpotLight,
 };
-use crate::emitter::{AreaLight, SphereLight};
+use crate::emitter::{AreaLight, IesLight, SphereLight};
 use crate::frame::Frame;
 use crate::instancing::InstanceAccel;
 use crate::integrator::MAX_TRANSPARENT;
@@ -604,7 +604,19 @@ impl LightParts {
                     irradiance,
                     angle,
                 } => EmitterInstance::Directional(Directional::new(direction, irradiance, angle)),
-                Light::Blender { shape, .. } => blender_emitter(&shape),
+                Light::Blender {
+                    shape, ref profile, ..
+                } => {
+                    let light = blender_emitter(&shape);
+                    match profile {
+                        Some(p) => EmitterInstance::Ies(IesLight::new(
+                            light,
+                            p.profile.clone(),
+                            p.to_local,
+                        )),
+                        None => light,
+                    }
+                }
             });
         }
         let mut background = None;
@@ -626,7 +638,7 @@ impl LightParts {
         }
         let (mut light_shapes, mut bounds, mut suns) = (Vec::new(), Vec::new(), Vec::new());
         for (i, e) in emitters.iter().enumerate() {
-            match e {
+            match e.shape() {
                 EmitterInstance::Sphere(s) => {
                     light_shapes.push(i as u32);
                     bounds.push((s.position - s.radius, s.position + s.radius));
@@ -1047,7 +1059,7 @@ impl RenderScene {
             {
                 return;
             }
-            let hit = match &self.emitters[e as usize] {
+            let hit = match self.emitters[e as usize].shape() {
                 EmitterInstance::Sphere(s) => s.intersect(o, d, tmax),
                 EmitterInstance::AreaLight(a) => a.intersect(o, d, tmax).map(|t| (t, a.normal)),
                 _ => None,
@@ -2007,7 +2019,7 @@ fn light_bounds(scene: &Scene, e: &EmitterInstance) -> Option<LightBounds> {
         theta_o: spot_cos_outer(f).clamp(-1.0, 1.0).acos(),
         theta_e: 0.0,
     };
-    Some(match e {
+    Some(match e.shape() {
         EmitterInstance::Area(a) => {
             let m = &scene.meshes[a.mesh];
             let lo = m.positions.iter().fold(Vec3::INFINITY, |l, p| l.min(*p));

@@ -64,6 +64,7 @@ fn floor_scene(cam_h: f32) -> Scene {
 
 fn blender(shape: LightShape) -> Light {
     Light::Blender {
+        profile: None,
         shape,
         visibility: LightVisibility::default(),
     }
@@ -374,6 +375,7 @@ fn lights_do_not_occlude_and_follow_their_visibility() {
         }
         s.lights.push(blender(up));
         s.lights.push(Light::Blender {
+            profile: None,
             shape: point(v(0.0, 2.0, 0.0), 100.0, 0.3, false),
             visibility: LightVisibility {
                 diffuse: false,
@@ -401,6 +403,7 @@ fn lights_do_not_occlude_and_follow_their_visibility() {
                 v(0.5, 1.0, 0.5),
             ));
             s.lights.push(Light::Blender {
+                profile: None,
                 shape: point(c, 30.0, 0.1, false),
                 visibility: LightVisibility {
                     cast_shadow,
@@ -426,6 +429,7 @@ fn lights_do_not_occlude_and_follow_their_visibility() {
         let mut s = Scene::default();
         let l0 = 100.0 / PI;
         s.lights.push(Light::Blender {
+            profile: None,
             shape: area_down(v(0.0, 2.0, 0.0), 1.0, 1.0, false, 100.0, PI),
             visibility: LightVisibility {
                 camera,

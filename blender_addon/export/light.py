@@ -3,7 +3,9 @@
 copy. The renderer applies Cycles' formulas; this module only reads Blender's settings."""
 
 import math
+import os
 
+import bpy
 import numpy as np
 
 from .. import compat
@@ -39,12 +41,36 @@ class LightGraph(MaterialGraph):
         return graph
 
 
-def node_emission(light, name, warn):
+def ies_profile(node, light_name, warn):
+    """The `ies` member of TESELA_light for an IES Texture node: the LM-63 text of its Text
+    datablock ('INTERNAL') or of its file ('EXTERNAL', relative to the .blend), or None (and
+    a report) when there is none to read; the renderer parses it."""
+    if node.mode == "INTERNAL":
+        text = node.ies
+        if text is None:
+            warn("light '%s': IES node '%s' has no Text; the light renders without a profile"
+                 % (light_name, node.name))
+            return None
+        return {"name": text.name, "data": text.as_string()}
+    path = bpy.path.abspath(node.filepath)
+    try:
+        with open(path, "rb") as f:
+            data = f.read().decode("utf-8", errors="replace")
+    except OSError as e:
+        warn("light '%s': IES file '%s' cannot be read (%s); the light renders without a "
+             "profile" % (light_name, node.filepath, e.strerror or e))
+        return None
+    return {"name": os.path.basename(path), "data": data}
+
+
+def node_emission(light, name, warn, profile=None, ies_warn=None):
     """The factor a light's node tree puts on its colour: Cycles multiplies the light's own
-    strength by what its shader emits. Emission's unlinked Color x Strength, and Light Falloff's
-    Quadratic (the physical falloff) into Strength; anything else renders with those unlinked
-    values and is reported through `warn` (the renderer may still evaluate the tree itself:
-    see convert_light)."""
+    strength by what its shader emits. Emission's unlinked Color x Strength, Light Falloff's
+    Quadratic (the physical falloff) into Strength, and an IES Texture into Strength (its
+    Strength input here, its profile appended to the list `profile`); anything else renders
+    with those unlinked values and is reported through `warn` (the renderer may still
+    evaluate the tree itself: see convert_light). What the IES node leaves out goes to
+    `ies_warn` (default `warn`): the tree itself is rendered."""
     nt = light.node_tree if getattr(light, "use_nodes", False) else None
     if nt is None:
         return (1.0, 1.0, 1.0)
@@ -69,11 +95,24 @@ def node_emission(light, name, warn):
     if src is not None:
         link = strength.links[0]
         falloff = src.bl_idname == "ShaderNodeLightFalloff" and not src.mute
+        ies = src.bl_idname == "ShaderNodeTexIES" and not src.mute
         if (falloff and link.from_socket.identifier == "Quadratic"
                 and not src.inputs["Strength"].is_linked
                 and not src.inputs["Smooth"].is_linked
                 and src.inputs["Smooth"].default_value == 0.0):
             k = finite(src.inputs["Strength"].default_value)
+        elif ies and profile is not None and light.type != "SUN":
+            k = finite(src.inputs["Strength"].default_value)
+            ies_warn = ies_warn or warn
+            if src.inputs["Strength"].is_linked:
+                ies_warn("light '%s': a linked IES Strength is not rendered; %g is used"
+                         % (name, k))
+            if src.inputs["Vector"].is_linked:
+                ies_warn("light '%s': a linked IES Vector is not rendered; the light's own "
+                         "direction is used" % name)
+            p = ies_profile(src, name, ies_warn)
+            if p is not None:
+                profile.append(p)
         else:
             warn("light '%s': emission strength from node '%s' (%s) is not rendered; %g is used"
                  % (name, src.name, link.from_socket.name, k))
@@ -88,9 +127,12 @@ def convert_light(light, obj, matrix=None, warnings=None, images=None):
     t = light.type
     base, scale = compat.light_color_and_scale(light)
     notes = []
-    factor = node_emission(light, obj.name, notes.append)
+    profile, ies_notes = [], []
+    factor = node_emission(light, obj.name, notes.append, profile, ies_notes.append)
     color = [c * f for c, f in zip(base[:3], factor)]
     ext = {"type": t, "color": color3(color)}
+    if profile:
+        ext["ies"] = profile[0]
     if notes and images is not None and light.node_tree is not None:
         graph_warnings = []
         ext["graph"] = LightGraph(light, images, TreeReport(graph_warnings, "light")).build()
@@ -98,7 +140,7 @@ def convert_light(light, obj, matrix=None, warnings=None, images=None):
         ext["node_warnings"] = notes
         notes = graph_warnings
     if warnings is not None:
-        warnings.extend(notes)
+        warnings.extend(notes + ies_notes)
     energy = finite(light.energy) * scale
     if t == "SUN":
         ext["strength"] = energy

@@ -10,6 +10,7 @@ pub mod area_light;
 pub mod background;
 pub mod directional;
 pub mod environment;
+pub mod ies;
 pub mod light_bvh;
 pub mod light_tree;
 pub mod point;
@@ -26,6 +27,7 @@ pub use area_light::AreaLight;
 pub use background::Background;
 pub use directional::Directional;
 pub use environment::Environment;
+pub use ies::IesLight;
 pub use point::PointLight;
 pub use sphere::SphereLight;
 pub use spot::SpotLight;
@@ -146,6 +148,19 @@ pub enum EmitterInstance {
     Sphere(SphereLight),
     /// A Blender area light.
     AreaLight(AreaLight),
+    /// A point, spot or area light shaped by an IES profile.
+    Ies(IesLight),
+}
+
+impl EmitterInstance {
+    /// The emitter's shape: an IES light's own light, any other emitter itself.
+    #[inline]
+    pub fn shape(&self) -> &EmitterInstance {
+        match self {
+            EmitterInstance::Ies(l) => &l.light,
+            e => e,
+        }
+    }
 }
 
 macro_rules! dispatch {
@@ -159,6 +174,7 @@ macro_rules! dispatch {
             EmitterInstance::Environment($e) => $body,
             EmitterInstance::Sphere($e) => $body,
             EmitterInstance::AreaLight($e) => $body,
+            EmitterInstance::Ies($e) => $body,
         }
     };
 }

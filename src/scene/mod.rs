@@ -615,11 +615,22 @@ pub enum Light {
         irradiance: Vec3,
         angle: f32,
     },
-    /// A Blender light (`TESELA_light`): its shape with Cycles' parameters, and which rays see it.
+    /// A Blender light (`TESELA_light`): its shape with Cycles' parameters, which rays see it,
+    /// and the IES profile its node tree applies, if any.
     Blender {
         shape: LightShape,
         visibility: LightVisibility,
+        profile: Option<LightProfile>,
     },
+}
+
+/// An IES profile on a light: its emitted radiance towards world direction `w` (leaving the
+/// light) is multiplied by `profile.towards(to_local · w)`, `to_local` the transpose of the
+/// light node's world matrix (Cycles takes the direction into light object space as a normal).
+#[derive(Clone, Debug)]
+pub struct LightProfile {
+    pub profile: std::sync::Arc<crate::emitter::ies::IesProfile>,
+    pub to_local: glam::Mat3,
 }
 
 /// The shape of a Blender light, with the parameters Cycles renders it from.

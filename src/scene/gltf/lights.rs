@@ -3,11 +3,14 @@
 
 use std::f32::consts::{FRAC_PI_4, PI};
 
-use glam::{Mat4, Vec3};
+use std::sync::Arc;
+
+use glam::{Mat3, Mat4, Vec3};
 use serde_json::Value;
 
 use super::{LoadError, Loader, extension, invalid, member, num, rgb};
-use crate::scene::{Light, LightShape, LightVisibility, SpotFalloff};
+use crate::emitter::ies::IesProfile;
+use crate::scene::{Light, LightProfile, LightShape, LightVisibility, SpotFalloff};
 
 /// Lumens per watt used to turn glTF's photometric units into radiometric ones.
 pub(crate) const LM_PER_W: f32 = 683.0;
@@ -312,8 +315,50 @@ impl<'a> Loader<'a> {
                 return skip(self, &format!("unknown type `{other}`"));
             }
         };
-        self.scene.lights.push(Light::Blender { shape, visibility });
+        let profile = self.light_profile(ni, ty, t, world);
+        self.scene.lights.push(Light::Blender {
+            shape,
+            visibility,
+            profile,
+        });
         Ok(())
+    }
+
+    /// The IES profile of a `TESELA_light` (`ies`: `{"name", "data"}`, the LM-63 text).
+    /// A profile that cannot be read is reported, naming the light and the file, and the
+    /// light renders without it.
+    fn light_profile(
+        &mut self,
+        ni: usize,
+        ty: &str,
+        t: &Value,
+        world: Mat4,
+    ) -> Option<LightProfile> {
+        let ies = member(t, "ies").filter(|v| !v.is_null())?;
+        let light = member(self.raw_item("nodes", ni), "name")
+            .and_then(Value::as_str)
+            .map_or_else(|| format!("node {ni}"), |n| format!("'{n}'"));
+        let file = member(ies, "name")
+            .and_then(Value::as_str)
+            .unwrap_or("(unnamed)")
+            .to_string();
+        let profile = match member(ies, "data").and_then(Value::as_str) {
+            _ if ty == "SUN" => Err("a sun's IES profile is not rendered".to_string()),
+            Some(text) => IesProfile::parse(text),
+            None => Err("`ies` has no `data` text".to_string()),
+        };
+        match profile {
+            Ok(p) => Some(LightProfile {
+                profile: Arc::new(p),
+                to_local: Mat3::from_mat4(world).transpose(),
+            }),
+            Err(e) => {
+                self.warn_once(format!(
+                    "light {light}: IES profile '{file}': {e}; the light renders without it"
+                ));
+                None
+            }
+        }
     }
 }
 

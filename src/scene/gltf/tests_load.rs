@@ -404,7 +404,9 @@ fn tesela_light_overrides_the_khr_copy() {
     let s = load(&bytes);
     assert_eq!(s.lights.len(), 3);
     let blender = |i: usize| match &s.lights[i] {
-        Light::Blender { shape, visibility } => (*shape, *visibility),
+        Light::Blender {
+            shape, visibility, ..
+        } => (*shape, *visibility),
         l => panic!("{l:?}"),
     };
     let (shape, vis) = blender(0);
