@@ -342,8 +342,8 @@ fn uris_outside_the_scene_folder_are_refused() {
 fn unsupported_required_extensions() {
     let bin = triangle_bin(&TRI, [0, 1, 2]);
     for ext in [
-        "KHR_draco_mesh_compression",
-        "EXT_meshopt_compression",
+        "KHR_texture_basisu",
+        "EXT_lights_image_based",
         "KHR_materials_iridescence",
     ] {
         let mut d = embedded(&bin);
