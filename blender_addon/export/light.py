@@ -141,6 +141,12 @@ def convert_light(light, obj, matrix=None, warnings=None, images=None):
         notes = graph_warnings
     if warnings is not None:
         warnings.extend(notes + ies_notes)
+        bounces = getattr(getattr(light, "cycles", None), "max_bounces", 1024)
+        if bounces != 1024:
+            # Cycles stops the light's contribution after that many bounces; Tesela has no
+            # per-light limit.
+            warnings.append("light '%s': its Max Bounces (%d) is not rendered; the light "
+                            "reaches every bounce" % (obj.name, bounces))
     energy = finite(light.energy) * scale
     if t == "SUN":
         ext["strength"] = energy

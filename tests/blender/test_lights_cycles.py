@@ -429,3 +429,19 @@ def test_portals_are_left_out_motion_blur_reported_and_light_linking_exported(ad
                for n in doc["nodes"]}
         assert ext["Lamp"] == {"receivers": 0}, ext
         assert ext["Box"] == {"links": [[0, "INCLUDE"]]}, ext
+
+
+def test_a_lights_own_max_bounces_is_reported(addon, tmp_path):  # noqa: F811
+    """Cycles' per-light Max Bounces has no counterpart in Tesela: a light that changes it is
+    reported, naming the light; one at the default (1024) is not."""
+    from blender_addon import export
+    scenes.clear_scene()
+    limited = scenes.add_point_light("Limited", (0, 0, 2), 100.0)
+    limited.data.cycles.max_bounces = 3
+    scenes.add_point_light("Plain", (1, 0, 2), 100.0)
+    scenes.add_camera((0, -5, 1), (0, 0, 0))
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    depsgraph.update()
+    res = export.write_gltf(depsgraph, str(tmp_path / "b.gltf"), width=8, height=8)
+    about = [w for w in res.warnings if "Max Bounces" in w]
+    assert len(about) == 1 and "'Limited'" in about[0] and "(3)" in about[0], res.warnings
