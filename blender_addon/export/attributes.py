@@ -75,10 +75,11 @@ def view_layer_value(view_layer, name):
     return None
 
 
-def requested_names(obj):
-    """{"OBJECT": names, "INSTANCER": names}: what the Attribute nodes of `obj`'s materials
-    (and their groups) read by those types."""
-    out = {"OBJECT": set(), "INSTANCER": set()}
+def material_reads(obj):
+    """What `obj`'s materials (and their node groups) read of the object, found in one walk
+    of their trees: {"OBJECT": names, "INSTANCER": names} of their Attribute nodes of those
+    types, and "PARTICLE_INFO": whether one has a Particle Info node."""
+    out = {"OBJECT": set(), "INSTANCER": set(), "PARTICLE_INFO": False}
     seen = set()
 
     def walk(tree):
@@ -88,8 +89,10 @@ def requested_names(obj):
         for node in tree.nodes:
             if node.bl_idname == ATTRIBUTE_NODE:
                 kind = getattr(node, "attribute_type", "GEOMETRY")
-                if kind in out and node.attribute_name:
+                if kind in ("OBJECT", "INSTANCER") and node.attribute_name:
                     out[kind].add(node.attribute_name)
+            elif node.bl_idname == "ShaderNodeParticleInfo":
+                out["PARTICLE_INFO"] = True
             elif node.bl_idname == "ShaderNodeGroup":
                 walk(node.node_tree)
 

@@ -10,7 +10,7 @@ import time
 import numpy as np
 
 from .. import compat
-from .attributes import InstanceAttributes, requested_names
+from .attributes import InstanceAttributes, material_reads
 from .buffer import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT, UINT, Buffer
 from .camera import camera_extension, camera_fields, camera_matrix
 from .common import ExportCancelled, Phases, gltf_matrix, matrix
@@ -99,8 +99,9 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     mesh_cache = {}  # (geometry key, glTF materials) -> (mesh index, triangles, texspace)
     store_files = {}  # mesh store digest -> its first accessor here
     object_cache = {}  # (object name, data) -> the mesh_cache entry
-    attribute_names = {}  # object name -> the Attribute node names its materials read
+    reads_of = {}  # object name -> what its materials read of it (attributes.material_reads)
     instance_attributes = InstanceAttributes()
+    frame = compat.frame_final(depsgraph.scene)
     mesh_nodes = {}  # glTF mesh index -> nodes placing it
     khr_lights = []
 
@@ -120,6 +121,18 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
         doc["materials"].append(m)
         material_index[key] = (len(doc["materials"]) - 1, tangent_uvs)
         return material_index[key]
+
+    def slot_materials(slots):
+        """The glTF material of each material of `slots` (None for an empty slot)."""
+        return [None if m is None else mat_idx(m)[0] for m in slots]
+
+    def tesela_object(inst, obj):
+        """extras.tesela_object of instance `inst` of `obj` (its materials walked once per
+        object)."""
+        reads = reads_of.get(obj.name)
+        if reads is None:
+            reads = reads_of[obj.name] = material_reads(obj)
+        return object_extras(inst, obj, depsgraph.view_layer, frame, reads, instance_attributes)
 
     def add_node(node):
         doc["nodes"].append(node)
@@ -260,8 +273,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             hair = _rendered_hair(obj)
             if hair:
                 hair_reported.add(obj.name)
-                slots = [s.material for s in obj.material_slots]
-                mats = [None if m is None else mat_idx(m)[0] for m in slots]
+                mats = slot_materials([s.material for s in obj.material_slots])
                 to_object = np.linalg.inv(matrix(inst.matrix_world))
                 for psys in obj.particle_systems:
                     if psys.name not in hair:
@@ -274,8 +286,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                               "matrix": gltf_matrix(matrix(inst.matrix_world)),
                               "extensions": {"TESELA_curves": ext},
                               "extras": {"tesela_object": object_extras(
-                                  inst, obj, depsgraph.view_layer,
-                                  compat.frame_final(depsgraph.scene))}})
+                                  inst, obj, depsgraph.view_layer, frame)}})
                     used_ext.add("TESELA_curves")
         if otype in MESHLIKE and not compat.row_is_geometry(obj):
             continue
@@ -289,12 +300,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                 continue
             mi, ntri, texspace = cached
             res.triangles += ntri
-            names = attribute_names.get(obj.name)
-            if names is None:
-                names = attribute_names[obj.name] = requested_names(obj)
-            extras = {"tesela_object": object_extras(inst, obj, depsgraph.view_layer,
-                                                     compat.frame_final(depsgraph.scene),
-                                                     names, instance_attributes)}
+            extras = {"tesela_object": tesela_object(inst, obj)}
             if texspace is not None:
                 extras["tesela_texspace"] = {"location": texspace[0], "size": texspace[1]}
             node = {"name": obj.name, "mesh": mi, "matrix": gltf_matrix(matrix(inst.matrix_world)),
@@ -307,17 +313,11 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             add_node(node)
         elif otype == "CURVES":
             slots = [s.material for s in obj.material_slots] or list(obj.data.materials)
-            ext = curves_extension(obj.data, [None if m is None else mat_idx(m)[0] for m in slots],
-                                   buf)
+            ext = curves_extension(obj.data, slot_materials(slots), buf)
             if ext is not None:
-                names = attribute_names.get(obj.name)
-                if names is None:
-                    names = attribute_names[obj.name] = requested_names(obj)
-                extras = {"tesela_object": object_extras(inst, obj, depsgraph.view_layer,
-                                                         compat.frame_final(depsgraph.scene),
-                                                         names, instance_attributes)}
                 add_node({"name": obj.name, "matrix": gltf_matrix(matrix(inst.matrix_world)),
-                          "extensions": {"TESELA_curves": ext}, "extras": extras})
+                          "extensions": {"TESELA_curves": ext},
+                          "extras": {"tesela_object": tesela_object(inst, obj)}})
                 used_ext.add("TESELA_curves")
         elif otype in ("POINTCLOUD", "VOLUME", "GPENCIL", "GREASEPENCIL"):
             if otype not in skipped_types:

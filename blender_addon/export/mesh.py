@@ -684,32 +684,13 @@ def random_number(rid):
     return float(np.float32(rid)) * 2.0 ** -32  # (float)0xFFFFFFFF rounds to 2^32
 
 
-def _reads_particle_info(obj):
-    """Whether a material of `obj` has a Particle Info node (in its tree or its groups)."""
-    seen = set()
-
-    def walk(tree):
-        if tree is None or tree.as_pointer() in seen:
-            return False
-        seen.add(tree.as_pointer())
-        for node in tree.nodes:
-            if node.bl_idname == "ShaderNodeParticleInfo":
-                return True
-            if node.bl_idname == "ShaderNodeGroup" and walk(node.node_tree):
-                return True
-        return False
-
-    return any(slot.material is not None and walk(slot.material.node_tree)
-               for slot in getattr(obj, "material_slots", ()))
-
-
-def particle_extras(inst, obj, frame):
+def particle_extras(inst, frame):
     """tesela_object.particle: the particle that placed instance `inst`, as Cycles reads it for
     Particle Info (index, age in frames at `frame`, lifetime, location, size, velocity and
-    angular velocity, Blender's world coordinates); None for other objects, for child
-    particles (Cycles has no data for them either) and when no material reads it."""
+    angular velocity, Blender's world coordinates); None for other objects and for child
+    particles (Cycles has no data for them either)."""
     psys = getattr(inst, "particle_system", None) if inst.is_instance else None
-    if psys is None or not _reads_particle_info(obj):
+    if psys is None:
         return None
     index = int(inst.persistent_id[0])
     particles = psys.particles
@@ -722,24 +703,24 @@ def particle_extras(inst, obj, frame):
             "angular_velocity": [float(v) for v in pa.angular_velocity]}
 
 
-def object_extras(inst, obj, view_layer=None, frame=0.0, attribute_names=None,
-                  instance_attributes=None):
-    """extras.tesela_object: what Object Info and Particle Info read (Blender's world
-    coordinates; `frame` is the render's frame, for a particle's age), the values of the
-    Attribute node's Object and Instancer types its materials read (`attribute_names`, see
-    attributes.requested_names; `instance_attributes` an attributes.InstanceAttributes), the ray visibility (Indirect Only clearing the camera's) and
-    whether the object is a holdout or a shadow catcher (its own or its instancer's)."""
+def object_extras(inst, obj, view_layer=None, frame=0.0, reads=None, instance_attributes=None):
+    """extras.tesela_object: what Object Info reads (Blender's world coordinates), and what
+    the object's materials read of it (`reads`, see attributes.material_reads): Particle Info
+    (`frame` is the render's frame, for a particle's age) and the values of the Attribute
+    node's Object and Instancer types (`instance_attributes` an
+    attributes.InstanceAttributes); the ray visibility (Indirect Only clearing the camera's)
+    and whether the object is a holdout or a shadow catcher (its own or its instancer's)."""
     rid = random_id(inst, obj)
     m = inst.matrix_world
     out = {"random": random_number(rid), "random_id": rid,
            "pass_index": int(getattr(obj, "pass_index", 0)),
            "color": [float(v) for v in getattr(obj, "color", (1.0, 1.0, 1.0, 1.0))],
            "location": [float(m[0][3]), float(m[1][3]), float(m[2][3])]}
-    particle = particle_extras(inst, obj, frame)
-    if particle is not None:
-        out["particle"] = particle
-    if attribute_names is not None:
-        values = object_attributes(inst, obj, attribute_names, instance_attributes)
+    if reads is not None:
+        particle = particle_extras(inst, frame) if reads["PARTICLE_INFO"] else None
+        if particle is not None:
+            out["particle"] = particle
+        values = object_attributes(inst, obj, reads, instance_attributes)
         if values is not None:
             out["attributes"] = values
     # An instance is hidden from the rays its object or its instancer is hidden from, and is
