@@ -128,19 +128,25 @@ fn perpendicular(t: Vec3) -> Vec3 {
 }
 
 impl Tubes {
-    /// The `sides` vertices of `ring` around its centre, in the plane of `u` and `t × u`.
-    fn ring(&mut self, ring: &Ring) -> u32 {
-        let Ring { c, r, t, u, info } = *ring;
+    /// A vertex of `ring` at `c + r n` (unit outward normal `n`).
+    fn vertex(&mut self, ring: &Ring, n: Vec3) {
+        self.positions.push(ring.c + ring.r * n);
+        self.normals.push(n);
+        self.tangents.push(ring.t.extend(1.0));
+        self.info.push(ring.info);
+    }
+
+    /// The `sides` vertices around `ring`'s centre whose normals leave the plane of `u` and
+    /// `t × u` by the angle `lift` towards `dir` (0: the ring itself); the first one's index.
+    fn circle(&mut self, ring: &Ring, lift: f32, dir: Vec3) -> u32 {
         let first = self.positions.len() as u32;
-        let v = t.cross(u);
+        let v = ring.t.cross(ring.u);
         let sides = self.detail.sides;
+        let (sin_lift, cos_lift) = lift.sin_cos();
         for k in 0..sides {
             let a = std::f32::consts::TAU * k as f32 / sides as f32;
-            let n = u * a.cos() + v * a.sin();
-            self.positions.push(c + r * n);
-            self.normals.push(n);
-            self.tangents.push(t.extend(1.0));
-            self.info.push(info);
+            let n = (ring.u * a.cos() + v * a.sin()) * cos_lift + dir * sin_lift;
+            self.vertex(ring, n);
         }
         first
     }
@@ -157,24 +163,14 @@ impl Tubes {
 
     /// A hemispherical cap on the vertices `edge` of `ring`, bulging along `dir` (±its tangent).
     fn cap(&mut self, edge: u32, ring: &Ring, dir: Vec3) {
-        let Ring { c, r, t, u, info } = *ring;
-        let at_tip = dir.dot(t) > 0.0;
+        let at_tip = dir.dot(ring.t) > 0.0;
         let mut prev = edge;
         let Detail {
             sides, cap_rings, ..
         } = self.detail;
         for i in 1..=cap_rings {
-            let a = std::f32::consts::FRAC_PI_2 * i as f32 / (cap_rings + 1) as f32;
-            let first = self.positions.len() as u32;
-            let v = t.cross(u);
-            for k in 0..sides {
-                let b = std::f32::consts::TAU * k as f32 / sides as f32;
-                let n = (u * b.cos() + v * b.sin()) * a.cos() + dir * a.sin();
-                self.positions.push(c + r * n);
-                self.normals.push(n);
-                self.tangents.push(t.extend(1.0));
-                self.info.push(info);
-            }
+            let lift = std::f32::consts::FRAC_PI_2 * i as f32 / (cap_rings + 1) as f32;
+            let first = self.circle(ring, lift, dir);
             if at_tip {
                 self.band(prev, first);
             } else {
@@ -183,10 +179,7 @@ impl Tubes {
             prev = first;
         }
         let pole = self.positions.len() as u32;
-        self.positions.push(c + r * dir);
-        self.normals.push(dir);
-        self.tangents.push(t.extend(1.0));
-        self.info.push(info);
+        self.vertex(ring, dir);
         let sides = sides as u32;
         for k in 0..sides {
             let k1 = (k + 1) % sides;
@@ -287,7 +280,7 @@ pub fn tessellate(s: &Strands) -> Tubes {
                 u,
                 info: info(r, x),
             };
-            let at = out.ring(&ring);
+            let at = out.circle(&ring, 0.0, ring.t);
             match prev {
                 Some((p, _)) => out.band(p, at),
                 None => first = Some((at, ring)),
