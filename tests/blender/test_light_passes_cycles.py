@@ -26,6 +26,8 @@ import pytest
 
 import imgcompare
 import scenes
+import test_passes_cycles
+from test_passes_cycles import render_multilayer
 
 OpenEXR = pytest.importorskip("OpenEXR")
 
@@ -83,30 +85,9 @@ def build_scene():
     return info.scene
 
 
-def render_multilayer(path):
-    scene = bpy.context.scene
-    s = scene.render.image_settings
-    if hasattr(s, "media_type"):
-        s.media_type = "MULTI_LAYER_IMAGE"
-    s.file_format = "OPEN_EXR_MULTILAYER"
-    s.color_depth = "32"
-    scene.render.use_file_extension = False
-    scene.render.filepath = str(path)
-    assert bpy.ops.render.render(write_still=True) == {"FINISHED"}
-    layers = {}
-    for part in OpenEXR.File(str(path)).parts:
-        for name, ch in part.channels.items():
-            px = np.asarray(ch.pixels, dtype=np.float32)
-            layers[name.split(".", 1)[1] if "." in name else name] = px.reshape(H, W, -1)
-    return layers
-
-
 def pass_of(layers, name):
-    if name in layers:
-        return layers[name][..., :3]
-    parts = sorted((k, v) for k, v in layers.items() if k.split(".")[0] == name)
-    assert parts, f"no {name} pass in {sorted(layers)}"
-    return np.concatenate([v for _, v in parts], axis=-1)[..., :3]
+    """The RGB of one pass (see test_passes_cycles.pass_of)."""
+    return test_passes_cycles.pass_of(layers, name)[..., :3]
 
 
 @pytest.fixture(scope="module")

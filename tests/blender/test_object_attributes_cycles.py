@@ -3,16 +3,12 @@ Cycles: values Blender looks up by name on data-blocks (custom properties, prope
 as ``color``), not on the geometry. Criteria as tests/blender/test_instances_cycles.py."""
 
 import math
-import os
 
 import bpy
 import pytest
 
-import imgcompare
 import scenes
-from test_addon import result_pixels
-
-SIZE = 64
+from test_instances_cycles import assert_agrees_with_cycles
 
 
 def attribute_material(name, attr_type, attr_name, output="Color"):
@@ -165,16 +161,4 @@ CASES = [("object", object_type), ("instancer", instancer_type),
 def test_attribute_types_agree_with_cycles(addon, tesela_bin, tmp_path, monkeypatch, case):
     name, build = case
     monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
-    scene = build()
-    scenes.configure_cycles(scene, SIZE, SIZE, 128, 0, seed=7)
-    ref = imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
-    scene.render.engine = "TESELA"
-    t = scene.tesela
-    scenes.tesela_like_cycles(t)
-    t.integrator, t.samples, t.max_depth, t.seed = "direct_mis", 128, 2, 1
-    t.threads = int(os.environ.get("TESELA_TEST_THREADS", "0"))
-    assert bpy.ops.render.render() == {"FINISHED"}
-    got = result_pixels(tmp_path)
-    result = imgcompare.compare(got, ref, mean_tol=0.02, block_tol=0.05)
-    print(f"attribute {name}: {result}")
-    assert result.ok, f"attribute {name}: Tesela (add-on) vs Cycles: {result}"
+    assert_agrees_with_cycles(build(), f"attribute {name}", 128, tmp_path)

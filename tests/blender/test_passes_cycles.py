@@ -77,8 +77,11 @@ def build_scene():
 
 
 def render_multilayer(path):
-    """Renders the scene and writes every pass to a multi-layer EXR; returns its passes."""
+    """Renders the scene and writes every pass to a multi-layer EXR; returns its passes, each
+    (h, w, c) at the scene's resolution."""
     scene = bpy.context.scene
+    pct = scene.render.resolution_percentage / 100.0
+    h, w = round(scene.render.resolution_y * pct), round(scene.render.resolution_x * pct)
     s = scene.render.image_settings
     if hasattr(s, "media_type"):
         s.media_type = "MULTI_LAYER_IMAGE"
@@ -91,7 +94,7 @@ def render_multilayer(path):
     for part in OpenEXR.File(str(path)).parts:  # Blender 5 writes one part per pass
         for name, ch in part.channels.items():
             px = np.asarray(ch.pixels, dtype=np.float32)
-            layers[name.split(".", 1)[1] if "." in name else name] = px.reshape(H, W, -1)
+            layers[name.split(".", 1)[1] if "." in name else name] = px.reshape(h, w, -1)
     return layers
 
 

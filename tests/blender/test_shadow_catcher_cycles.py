@@ -126,25 +126,7 @@ def test_shadow_catcher_pass_agrees_with_cycles(addon, tesela_bin, tmp_path, mon
     """View Layer > Passes > Shadow Catcher (view_layer.cycles.use_pass_shadow_catcher): the
     pass (the shadow over white) and Combined, which becomes the matte alone (the box over
     transparency), both as Cycles writes them."""
-    from test_passes_cycles import pass_of
-
-    def render_multilayer(path):
-        import OpenEXR
-        settings = scene.render.image_settings
-        if hasattr(settings, "media_type"):
-            settings.media_type = "MULTI_LAYER_IMAGE"
-        settings.file_format = "OPEN_EXR_MULTILAYER"
-        settings.color_depth = "32"
-        scene.render.use_file_extension = False
-        scene.render.filepath = str(path)
-        assert bpy.ops.render.render(write_still=True) == {"FINISHED"}
-        layers = {}
-        for part in OpenEXR.File(str(path)).parts:
-            for name, ch in part.channels.items():
-                px = np.asarray(ch.pixels, dtype=np.float32)
-                layers[name.split(".", 1)[1] if "." in name else name] = px.reshape(
-                    SIZE, SIZE, -1)
-        return layers
+    from test_passes_cycles import pass_of, render_multilayer
 
     monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
     scene = box_on_catcher(diffuse_floor)
