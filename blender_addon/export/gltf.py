@@ -315,10 +315,15 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             slots = [s.material for s in obj.material_slots] or list(obj.data.materials)
             ext = curves_extension(obj.data, slot_materials(slots), buf)
             if ext is not None:
-                add_node({"name": obj.name, "matrix": gltf_matrix(matrix(inst.matrix_world)),
-                          "extensions": {"TESELA_curves": ext},
-                          "extras": {"tesela_object": tesela_object(inst, obj)}})
+                exts = {"TESELA_curves": ext}
                 used_ext.add("TESELA_curves")
+                link = linking.extension(obj, inst.parent if inst.is_instance else None)
+                if link is not None:
+                    exts["TESELA_light_linking"] = link
+                    used_ext.add("TESELA_light_linking")
+                add_node({"name": obj.name, "matrix": gltf_matrix(matrix(inst.matrix_world)),
+                          "extensions": exts,
+                          "extras": {"tesela_object": tesela_object(inst, obj)}})
         elif otype in ("POINTCLOUD", "VOLUME", "GPENCIL", "GREASEPENCIL"):
             if otype not in skipped_types:
                 skipped_types.add(otype)

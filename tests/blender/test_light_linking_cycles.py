@@ -96,11 +96,28 @@ def nested_states():
     return scenes.SceneInfo(scene, "nested_states")
 
 
+def strands_in_a_receiver_collection():
+    """Hair strands (a Curves object) that a warm spot light alone lights, by its receiver
+    collection, beside the two boxes, which only a cool point light reaches; the strands shadow
+    the floor from both lights."""
+    from test_curves_cycles import glossy, strands
+
+    scene, left, right = _stage()
+    hair = strands(24, 5, 0.03, glossy(), spread=0.5, height=0.7)
+    hair.location = (0.0, 0.8, 0.0)
+    warm = scenes.add_point_light("Warm", (-0.4, -0.5, 1.8), 300.0, color=(1.0, 0.7, 0.4),
+                                  radius=0.2)
+    scenes.add_point_light("Cool", (1.2, -0.8, 2.2), 200.0, color=(0.5, 0.7, 1.0), radius=0.2)
+    warm.light_linking.receiver_collection = _collection("HairOnly", [(hair, "INCLUDE")])
+    return scenes.SceneInfo(scene, "strands_in_a_receiver_collection")
+
+
 CASES = [
     ("lamp_linked_to_one_box", lamp_linked_to_one_box, 2, "path_mis", 256),
     ("emissive_mesh_excluding_the_floor", emissive_mesh_excluding_the_floor, 2, "path_mis", 256),
     ("blocker_collection", blocker_collection, 1, "path_mis", 256),
     ("nested_states", nested_states, 1, "path_mis", 256),
+    ("strands_in_a_receiver_collection", strands_in_a_receiver_collection, 1, "path_mis", 256),
 ]
 
 
