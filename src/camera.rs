@@ -75,8 +75,8 @@ impl RayCamera {
     /// (the vertical field of view for glTF cameras).
     pub fn new(scene: &Scene, width: u32, height: u32) -> RayCamera {
         let cam = scene.camera.unwrap_or_else(|| default_camera(scene));
-        let aspect = width as f32 / height as f32;
-        let horizontal = cam.fit.is_horizontal(width, height);
+        let aspect = width as f32 * cam.pixel_aspect / height as f32;
+        let horizontal = cam.fit.is_horizontal(aspect);
         // Half extents of the image for a fitted half extent `h`.
         let extents = |h: f32| {
             if horizontal {
@@ -95,7 +95,7 @@ impl RayCamera {
                     _ => 1.0,
                 };
                 // Cycles' sensor size: the fitted dimension's, the other one by the aspect.
-                let (w, h) = (width as f32, height as f32);
+                let (w, h) = (width as f32 * cam.pixel_aspect, height as f32);
                 let s = if horizontal {
                     Vec2::new(sensor, sensor * h / w)
                 } else {
@@ -301,6 +301,7 @@ pub struct WindowMap {
     fitted: f32,
     fit: SensorFit,
     shift: Vec2,
+    pixel_aspect: f32,
     width: AtomicU32,
     height: AtomicU32,
 }
@@ -317,6 +318,7 @@ impl WindowMap {
             fitted: 1.0,
             fit: SensorFit::Auto,
             shift: Vec2::ZERO,
+            pixel_aspect: 1.0,
             width: AtomicU32::new(1),
             height: AtomicU32::new(1),
         }
@@ -337,6 +339,7 @@ impl WindowMap {
             fitted,
             fit: cam.fit,
             shift: cam.shift,
+            pixel_aspect: cam.pixel_aspect,
             width: AtomicU32::new(1),
             height: AtomicU32::new(1),
         }
@@ -370,9 +373,9 @@ impl WindowMap {
             self.width.load(Ordering::Relaxed),
             self.height.load(Ordering::Relaxed),
         );
-        let aspect = w as f32 / h as f32;
+        let aspect = w as f32 * self.pixel_aspect / h as f32;
         let f = self.fitted;
-        let half = if self.fit.is_horizontal(w, h) {
+        let half = if self.fit.is_horizontal(aspect) {
             Vec2::new(f, f / aspect)
         } else {
             Vec2::new(f * aspect, f)

@@ -9,13 +9,14 @@ import numpy as np
 from .common import finite, matrix
 
 
-def camera_fields(cam_data, width, height):
-    """glTF camera dict for a Blender camera at the render resolution."""
-    aspect = width / float(height)
+def camera_fields(cam_data, width, height, pixel_aspect=1.0):
+    """glTF camera dict for a Blender camera at the render resolution (`pixel_aspect`: a
+    pixel's width over its height; the glTF camera gets the image's physical shape)."""
+    aspect = width * pixel_aspect / float(height)
     if cam_data.type == "ORTHO":
         fit = cam_data.sensor_fit
         if fit == "AUTO":
-            fit = "HORIZONTAL" if width >= height else "VERTICAL"
+            fit = "HORIZONTAL" if aspect >= 1.0 else "VERTICAL"
         half = cam_data.ortho_scale / 2.0
         if fit == "HORIZONTAL":
             xmag, ymag = half, half / aspect
@@ -29,7 +30,7 @@ def camera_fields(cam_data, width, height):
     fit = cam_data.sensor_fit
     if fit == "AUTO":
         sensor = cam_data.sensor_width
-        if width >= height:
+        if aspect >= 1.0:
             half_w = sensor / (2.0 * f)
             half_h = half_w / aspect
         else:
@@ -88,7 +89,7 @@ def focus_distance(cam_obj):
     return finite(abs(float(np.dot(view, cm[:3, 3] - m[:3, 3]))))
 
 
-def camera_extension(cam_obj, warnings):
+def camera_extension(cam_obj, warnings, pixel_aspect=1.0):
     """TESELA_camera (docs/extensions.md) for a Blender camera object: its native data, the
     renderer applies Cycles' formulas to it."""
     cd = cam_obj.data
@@ -98,6 +99,8 @@ def camera_extension(cam_obj, warnings):
            "ortho_scale": finite(cd.ortho_scale),
            "shift_x": finite(cd.shift_x), "shift_y": finite(cd.shift_y),
            "clip_start": finite(cd.clip_start), "clip_end": finite(cd.clip_end, 1e30)}
+    if pixel_aspect != 1.0:
+        ext["pixel_aspect"] = pixel_aspect
     if cd.type == "CUSTOM":
         warnings.append("camera '%s': custom (OSL) cameras are not supported; rendering it as "
                         "a perspective camera" % cam_obj.name)
@@ -117,3 +120,9 @@ def camera_extension(cam_obj, warnings):
                       "aperture_rotation": finite(dof.aperture_rotation),
                       "aperture_ratio": finite(dof.aperture_ratio, 1.0)}
     return ext
+
+
+def pixel_aspect(render):
+    """A pixel's width over its height (Render Properties > Format > Aspect X / Y)."""
+    x, y = finite(render.pixel_aspect_x, 1.0), finite(render.pixel_aspect_y, 1.0)
+    return x / y if x > 0.0 and y > 0.0 else 1.0

@@ -12,7 +12,7 @@ import numpy as np
 from .. import compat
 from .attributes import InstanceAttributes, material_reads
 from .buffer import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT, UINT, Buffer
-from .camera import camera_extension, camera_fields, camera_matrix
+from .camera import camera_extension, camera_fields, camera_matrix, pixel_aspect
 from .common import ExportCancelled, Phases, gltf_matrix, matrix
 from .curves import curves_extension, particle_hair_extension
 from .images import ImageTable, Textures
@@ -357,13 +357,11 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
         warnings.append("motion blur is not rendered; objects render at the frame's instant")
     cam = camera if camera is not None else scene.camera
     if cam is not None and cam.type == "CAMERA":
-        r = scene.render
-        if abs(r.pixel_aspect_x - r.pixel_aspect_y) > 1e-6 * max(r.pixel_aspect_x, 1.0):
-            warnings.append("pixel aspect %g:%g is not supported; Tesela renders square pixels"
-                            % (r.pixel_aspect_x, r.pixel_aspect_y))
-        doc["cameras"].append(dict(camera_fields(cam.data, width, height), name=cam.data.name))
+        aspect = pixel_aspect(scene.render)
+        doc["cameras"].append(dict(camera_fields(cam.data, width, height, aspect),
+                                   name=cam.data.name))
         add_node({"name": cam.name, "camera": 0, "matrix": gltf_matrix(camera_matrix(cam)),
-                  "extensions": {"TESELA_camera": camera_extension(cam, warnings)}})
+                  "extensions": {"TESELA_camera": camera_extension(cam, warnings, aspect)}})
         used_ext.add("TESELA_camera")
         res.has_camera = True
 

@@ -731,11 +731,12 @@ pub enum SensorFit {
 }
 
 impl SensorFit {
-    /// Whether the fitted dimension is the width of a `width × height` image.
+    /// Whether the fitted dimension is the width of an image `aspect` times wider than tall
+    /// (its physical shape: pixels × pixel aspect).
     #[inline]
-    pub fn is_horizontal(self, width: u32, height: u32) -> bool {
+    pub fn is_horizontal(self, aspect: f32) -> bool {
         match self {
-            SensorFit::Auto => width > height,
+            SensorFit::Auto => aspect > 1.0,
             SensorFit::Horizontal => true,
             SensorFit::Vertical => false,
         }
@@ -812,6 +813,9 @@ pub struct Camera {
     pub to_world: Mat4,
     /// The file's aspect ratio (width/height), if it states one.
     pub aspect: Option<f32>,
+    /// A pixel's width over its height (Blender's `pixel_aspect_x / pixel_aspect_y`): the
+    /// image's shape, which fits and shapes the view, is `width · pixel_aspect : height`.
+    pub pixel_aspect: f32,
     /// The image dimension `projection`'s extent spans.
     pub fit: SensorFit,
     /// Lens shift (Blender `shift_x`, `shift_y`): the image window moves right and up by these
@@ -836,6 +840,7 @@ impl Default for Camera {
             },
             to_world: Mat4::IDENTITY,
             aspect: None,
+            pixel_aspect: 1.0,
             fit: SensorFit::Vertical,
             shift: Vec2::ZERO,
             clip_start: 0.0,

@@ -1,7 +1,7 @@
 """Blender cameras through the add-on (TESELA_camera) against Cycles on the same scene: depth of
 field with a polygonal, rotated, anamorphic bokeh and a focus object, lens shift on a wide image,
 an orthographic camera with vertical sensor fit and shift, Window texture coordinates (a camera projection,
-perspective and orthographic, shifted), clip start and end, and panoramic cameras
+perspective and orthographic, shifted), non-square pixels, clip start and end, and panoramic cameras
 (fisheye equisolid, equidistant and a partial equirectangular).
 
 Criteria (imgcompare.compare): each RGB channel's mean within 2%, 8x8 block means within 5% at
@@ -127,6 +127,16 @@ def window_projection(ortho):
     return info
 
 
+def pixel_aspect(x, y, then=lit_scene):
+    """Non-square pixels (Format > Aspect X/Y): the image's shape is width·x : height·y, which
+    picks AUTO's fitted dimension (96x64 pixels twice as tall are a portrait frame) and the other
+    dimension's extent; with a lens shift."""
+    info = then()
+    info.scene.render.pixel_aspect_x, info.scene.render.pixel_aspect_y = x, y
+    camera().shift_x = 0.1
+    return info
+
+
 def clip_start():
     """The near clip plane cuts away the front of the floor (the world shows there)."""
     info = lit_scene(world=0.5)
@@ -164,6 +174,10 @@ CASES = [
     ("ortho_vertical_shift", ortho_vertical_shift, 256),
     ("window_projection_perspective", lambda: window_projection(False), 64),
     ("window_projection_orthographic", lambda: window_projection(True), 64),
+    ("pixel_aspect_wide", lambda: pixel_aspect(1.6, 1.0), 256),
+    ("pixel_aspect_tall_auto_fit", lambda: pixel_aspect(1.0, 2.0), 256),
+    ("pixel_aspect_window_projection",
+     lambda: pixel_aspect(1.0, 1.5, lambda: window_projection(False)), 64),
     ("clip_start", clip_start, 256),
     ("clip_end", clip_end, 256),
     ("fisheye_equisolid", lambda: _pano("FISHEYE_EQUISOLID", fisheye_lens=8.0,

@@ -230,6 +230,9 @@ fn blender_camera(f: &mut Fields, gltf: Camera) -> Camera {
         _ => cam.projection = Projection::Panoramic(panorama(f, sensor_key)),
     }
     cam.shift = Vec2::new(f.num("shift_x", 0.0), f.num("shift_y", 0.0));
+    cam.pixel_aspect = f
+        .positive("pixel_aspect", 1.0, "square pixels are used")
+        .unwrap_or(1.0);
     let start = f.num("clip_start", 0.0);
     cam.clip_start = if start >= 0.0 {
         start
