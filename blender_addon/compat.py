@@ -452,6 +452,28 @@ def generic_attributes(mesh, n_by_domain, skip):
     return out
 
 
+def point_attributes(pointcloud, n, names):
+    """The point-domain attributes of a point cloud named in `names` as the Attribute node
+    reads them: a list of (name, float32 (n, 4)); colours as they are, the rest converted as
+    generic_attributes does."""
+    out = []
+    for a in getattr(pointcloud, "attributes", ()):
+        if a.name not in names or a.domain != "POINT":
+            continue
+        if a.data_type in ("FLOAT_COLOR", "BYTE_COLOR"):
+            v = np.empty(n * 4, dtype=np.float32)
+            try:
+                a.data.foreach_get("color", v)
+            except (TypeError, RuntimeError, AttributeError):
+                continue
+            out.append((a.name, v.reshape(n, 4)))
+    skip = {name for name, _ in out} | {a.name for a in getattr(pointcloud, "attributes", ())
+                                        if a.name not in names}
+    out += [(name, values) for name, _, values
+            in generic_attributes(pointcloud, {"POINT": n}, skip)]
+    return out
+
+
 def corner_tangents(mesh, uv_name, n_loops):
     """Blender's MikkTSpace tangents for a UV map: (float32 (n, 3), float32 (n,) bitangent sign).
     Raises RuntimeError where Blender cannot compute them (n-gons)."""

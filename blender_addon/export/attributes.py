@@ -77,9 +77,10 @@ def view_layer_value(view_layer, name):
 
 def material_reads(obj):
     """What `obj`'s materials (and their node groups) read of the object, found in one walk
-    of their trees: {"OBJECT": names, "INSTANCER": names} of their Attribute nodes of those
-    types, and "PARTICLE_INFO": whether one has a Particle Info node."""
-    out = {"OBJECT": set(), "INSTANCER": set(), "PARTICLE_INFO": False}
+    of their trees: {"OBJECT": names, "INSTANCER": names, "GEOMETRY": names} of their
+    Attribute nodes of those types, and "PARTICLE_INFO": whether one has a Particle Info
+    node."""
+    out = {"OBJECT": set(), "INSTANCER": set(), "GEOMETRY": set(), "PARTICLE_INFO": False}
     seen = set()
 
     def walk(tree):
@@ -89,7 +90,7 @@ def material_reads(obj):
         for node in tree.nodes:
             if node.bl_idname == ATTRIBUTE_NODE:
                 kind = getattr(node, "attribute_type", "GEOMETRY")
-                if kind in ("OBJECT", "INSTANCER") and node.attribute_name:
+                if kind in ("OBJECT", "INSTANCER", "GEOMETRY") and node.attribute_name:
                     out[kind].add(node.attribute_name)
             elif node.bl_idname == "ShaderNodeParticleInfo":
                 out["PARTICLE_INFO"] = True

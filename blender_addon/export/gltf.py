@@ -20,6 +20,7 @@ from .instances import collapse
 from .light import convert_light
 from .linking import LightLinking
 from .material import MaterialReport, default_surface, export_material
+from .points import points_extension
 from .mesh import (MESHLIKE, geometry_key, mesh_arrays, object_extras, read_mesh,
                    undeformed_positions)
 from .world import convert_world
@@ -126,13 +127,25 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
         """The glTF material of each material of `slots` (None for an empty slot)."""
         return [None if m is None else mat_idx(m)[0] for m in slots]
 
+    def reads(obj):
+        """What `obj`'s materials read of it (its materials walked once per object)."""
+        found = reads_of.get(obj.name)
+        if found is None:
+            found = reads_of[obj.name] = material_reads(obj)
+        return found
+
     def tesela_object(inst, obj):
-        """extras.tesela_object of instance `inst` of `obj` (its materials walked once per
-        object)."""
-        reads = reads_of.get(obj.name)
-        if reads is None:
-            reads = reads_of[obj.name] = material_reads(obj)
-        return object_extras(inst, obj, depsgraph.view_layer, frame, reads, instance_attributes)
+        """extras.tesela_object of instance `inst` of `obj`."""
+        return object_extras(inst, obj, depsgraph.view_layer, frame, reads(obj),
+                             instance_attributes)
+
+    def linked_node(node, obj, inst):
+        """`node` with the light linking of `obj` (instance `inst`), added to the scene."""
+        link = linking.extension(obj, inst.parent if inst.is_instance else None)
+        if link is not None:
+            node.setdefault("extensions", {})["TESELA_light_linking"] = link
+            used_ext.add("TESELA_light_linking")
+        add_node(node)
 
     def add_node(node):
         doc["nodes"].append(node)
@@ -282,12 +295,12 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                                                   depsgraph.mode == "RENDER")
                     if ext is None:
                         continue
-                    add_node({"name": "%s %s" % (obj.name, psys.name),
-                              "matrix": gltf_matrix(matrix(inst.matrix_world)),
-                              "extensions": {"TESELA_curves": ext},
-                              "extras": {"tesela_object": object_extras(
-                                  inst, obj, depsgraph.view_layer, frame)}})
                     used_ext.add("TESELA_curves")
+                    linked_node({"name": "%s %s" % (obj.name, psys.name),
+                                 "matrix": gltf_matrix(matrix(inst.matrix_world)),
+                                 "extensions": {"TESELA_curves": ext},
+                                 "extras": {"tesela_object": object_extras(
+                                     inst, obj, depsgraph.view_layer, frame)}}, obj, inst)
         if otype in MESHLIKE and not compat.row_is_geometry(obj):
             continue
         if otype in MESHLIKE and not getattr(inst, "show_self", True):
@@ -303,28 +316,29 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             extras = {"tesela_object": tesela_object(inst, obj)}
             if texspace is not None:
                 extras["tesela_texspace"] = {"location": texspace[0], "size": texspace[1]}
-            node = {"name": obj.name, "mesh": mi, "matrix": gltf_matrix(matrix(inst.matrix_world)),
-                    "extras": extras}
-            link = linking.extension(obj, inst.parent if inst.is_instance else None)
-            if link is not None:
-                node["extensions"] = {"TESELA_light_linking": link}
-                used_ext.add("TESELA_light_linking")
             mesh_nodes.setdefault(mi, []).append(len(doc["nodes"]))
-            add_node(node)
+            linked_node({"name": obj.name, "mesh": mi,
+                         "matrix": gltf_matrix(matrix(inst.matrix_world)), "extras": extras},
+                        obj, inst)
         elif otype == "CURVES":
             slots = [s.material for s in obj.material_slots] or list(obj.data.materials)
             ext = curves_extension(obj.data, slot_materials(slots), buf)
             if ext is not None:
-                exts = {"TESELA_curves": ext}
                 used_ext.add("TESELA_curves")
-                link = linking.extension(obj, inst.parent if inst.is_instance else None)
-                if link is not None:
-                    exts["TESELA_light_linking"] = link
-                    used_ext.add("TESELA_light_linking")
-                add_node({"name": obj.name, "matrix": gltf_matrix(matrix(inst.matrix_world)),
-                          "extensions": exts,
-                          "extras": {"tesela_object": tesela_object(inst, obj)}})
-        elif otype in ("POINTCLOUD", "VOLUME", "GPENCIL", "GREASEPENCIL"):
+                linked_node({"name": obj.name, "matrix": gltf_matrix(matrix(inst.matrix_world)),
+                             "extensions": {"TESELA_curves": ext},
+                             "extras": {"tesela_object": tesela_object(inst, obj)}}, obj, inst)
+        elif otype == "POINTCLOUD":
+            slots = [s.material for s in obj.material_slots] or list(obj.data.materials)
+            first = slot_materials(slots[:1])
+            ext = points_extension(obj.data, first[0] if first else None,
+                                   reads(obj)["GEOMETRY"], buf)
+            if ext is not None:
+                used_ext.add("TESELA_points")
+                linked_node({"name": obj.name, "matrix": gltf_matrix(matrix(inst.matrix_world)),
+                             "extensions": {"TESELA_points": ext},
+                             "extras": {"tesela_object": tesela_object(inst, obj)}}, obj, inst)
+        elif otype in ("VOLUME", "GPENCIL", "GREASEPENCIL"):
             if otype not in skipped_types:
                 skipped_types.add(otype)
                 warnings.append("%s objects are not supported; '%s' (and any others) left out"

@@ -12,6 +12,7 @@ pub mod error;
 pub mod gltf;
 pub mod gltf_write;
 pub mod instance;
+pub mod points;
 pub mod world;
 
 pub use error::{LoadError, LoadErrorKind};

@@ -20,6 +20,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import os
+
 import numpy as np
 
 
@@ -85,7 +87,14 @@ class Comparison:
 
 
 def compare(test, ref, mean_tol=0.03, block=8, block_tol=0.10, percentile=95.0):
-    """Compare image ``test`` against reference ``ref`` (arrays (h, w, >=3), same shape)."""
+    """Compare image ``test`` against reference ``ref`` (arrays (h, w, >=3), same shape).
+    With TESELA_TEST_DUMP set to a folder, both images are saved there (got.npy, ref.npy) to
+    look at a failure."""
+    dump = os.environ.get("TESELA_TEST_DUMP")
+    if dump:
+        os.makedirs(dump, exist_ok=True)
+        np.save(os.path.join(dump, "got.npy"), np.asarray(test))
+        np.save(os.path.join(dump, "ref.npy"), np.asarray(ref))
     test = np.asarray(test, dtype=np.float64)[..., :3]
     ref = np.asarray(ref, dtype=np.float64)[..., :3]
     if test.shape != ref.shape:

@@ -92,7 +92,8 @@ def clear_scene():
     if old_world is not None and old_world.users == 0:
         bpy.data.worlds.remove(old_world)
     for coll in (bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras,
-                 getattr(bpy.data, "hair_curves", ())):
+                 bpy.data.node_groups, getattr(bpy.data, "hair_curves", ()),
+                 getattr(bpy.data, "pointclouds", ())):
         for block in list(coll):
             if block.users == 0:
                 coll.remove(block)

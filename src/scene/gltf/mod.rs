@@ -24,6 +24,7 @@ mod linking;
 mod material;
 mod mesh;
 mod meshopt;
+mod points;
 mod skin;
 mod tangents;
 mod uri;
@@ -57,6 +58,7 @@ const MAX_VERTICES: usize = 1 << 25;
 const SUPPORTED_REQUIRED: &[&str] = &[
     "KHR_mesh_quantization",
     "TESELA_curves",
+    "TESELA_points",
     "KHR_draco_mesh_compression",
     "EXT_meshopt_compression",
     "KHR_meshopt_compression",
@@ -90,6 +92,7 @@ const SUPPORTED_REQUIRED: &[&str] = &[
 const UNDERSTOOD: &[&str] = &[
     "KHR_mesh_quantization",
     "TESELA_curves",
+    "TESELA_points",
     "KHR_draco_mesh_compression",
     "EXT_meshopt_compression",
     "KHR_meshopt_compression",
@@ -654,6 +657,7 @@ impl<'a> Loader<'a> {
                 });
             }
             self.node_curves(ni, world)?;
+            self.node_points(ni, world)?;
             self.origins.node_world.resize(n, Mat4::IDENTITY);
             self.origins.node_world[ni] = world;
             let lights = self.scene.lights.len();

@@ -19,6 +19,17 @@ pub enum HairOut {
     Random,
 }
 
+/// The outputs of the Point Info node (zero off point clouds, as in Cycles).
+#[derive(Clone, Copy, Debug)]
+pub enum PointOut {
+    /// The point's centre, world space.
+    Position,
+    /// The radius in world units: `|M (r/√3)(1, 1, 1)|`, `M` the object's linear map.
+    Radius,
+    /// Cycles' `hash_uint2_to_float(index, 0)`.
+    Random,
+}
+
 /// The outputs of the Particle Info node.
 #[derive(Clone, Copy, Debug)]
 pub enum ParticleOut {
@@ -63,6 +74,7 @@ pub enum Source {
     ObjectRandom,
     /// A Hair Info output of a point on a strand (zero elsewhere; Is Strand 0).
     Hair(HairOut),
+    Point(PointOut),
     /// A Particle Info output of the point's particle (Cycles' all-zero particle for an
     /// object no particle placed).
     Particle(ParticleOut),
@@ -233,6 +245,28 @@ impl InputOp {
                     }
                 };
                 s.set_f(self.out, value);
+            }
+            Source::Point(out) => {
+                use crate::scene::points::{POINT_LAYER, POINT_RANDOM_LAYER};
+                let point = g.color_attribute(POINT_LAYER);
+                let to_world = || g.to_object().map(|m| m.inverse()).filter(|m| m.is_finite());
+                match (out, point) {
+                    (PointOut::Position, Some(c)) => {
+                        let m = to_world().unwrap_or(glam::Mat4::IDENTITY);
+                        s.set_v(self.out, to_blender(m.transform_point3(c.truncate())));
+                    }
+                    (PointOut::Radius, Some(c)) => {
+                        let m = to_world().unwrap_or(glam::Mat4::IDENTITY);
+                        let d = Vec3::splat(c.w / 3f32.sqrt());
+                        s.set_f(self.out, m.transform_vector3(d).length());
+                    }
+                    (PointOut::Random, Some(_)) => {
+                        let r = g.color_attribute(POINT_RANDOM_LAYER).map_or(0.0, |v| v.x);
+                        s.set_f(self.out, r);
+                    }
+                    (PointOut::Position, None) => s.set_v(self.out, Vec3::ZERO),
+                    (_, None) => s.set_f(self.out, 0.0),
+                }
             }
             Source::Particle(out) => {
                 let none = crate::scene::Particle::default();
@@ -422,6 +456,11 @@ pub fn compile(kind: &str, cx: &mut NodeCx) -> Result<bool, CompileError> {
             let index = cx.prop_f32("material_pass_index", 0.0);
             let index = cx.constant(&[index])?;
             cx.alias("Material Index", index, Float);
+        }
+        "ShaderNodePointInfo" => {
+            emit(cx, "Position", Vector, Source::Point(PointOut::Position))?;
+            emit(cx, "Radius", Float, Source::Point(PointOut::Radius))?;
+            emit(cx, "Random", Float, Source::Point(PointOut::Random))?;
         }
         "ShaderNodeHairInfo" => {
             use HairOut as H;
