@@ -93,4 +93,9 @@ def unsupported(view_layer, settings=None):
     if settings is not None and not splits_light(settings):
         out += [bname for toggle, name, bname, _, _ in PASSES
                 if name in LIGHT and getattr(view_layer, toggle, False)]
+    # Shader AOVs (AOV Output nodes) and Cycles' light groups: passes the view layer adds by
+    # name.
+    out += ["AOV '%s'" % a.name for a in getattr(view_layer, "aovs", ()) if a.name]
+    out += ["light group '%s'" % g.name for g in getattr(view_layer, "lightgroups", ())
+            if g.name]
     return out

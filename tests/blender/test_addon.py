@@ -1073,6 +1073,11 @@ def test_light_passes_are_registered_with_blenders_names_and_channels():
     assert got["TransCol"] == ("transmission_color", "RGB", "COLOR")
     assert got["Noisy Image"] == ("noisy_image", "RGBA", "COLOR")
     assert passes.unsupported(layer, settings) == ["Shadow"]
+    # Shader AOVs and light groups the view layer adds are reported by name.
+    layer.aovs = [SimpleNamespace(name="Dirt")]
+    layer.lightgroups = [SimpleNamespace(name="Key"), SimpleNamespace(name="")]
+    assert passes.unsupported(layer, settings) == ["Shadow", "AOV 'Dirt'", "light group 'Key'"]
+    layer.aovs, layer.lightgroups = [], []
     # A view layer that opts out of denoising has no Noisy Image; neither has a render without
     # denoising.
     layer.cycles.use_denoising = False
