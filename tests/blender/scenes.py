@@ -82,6 +82,8 @@ def clear_scene():
     The world is replaced rather than edited: a test that changed its settings (sampling
     method, ray visibility, ...) must not change the renders of the tests after it."""
     scene = bpy.context.scene
+    # Square pixels: a test of non-square ones must not reshape the next tests' frames.
+    scene.render.pixel_aspect_x = scene.render.pixel_aspect_y = 1.0
     # Every object, also those only in collections the scene instances (not linked to it),
     # whose names a later test would otherwise find taken.
     for ob in list(bpy.data.objects):
