@@ -67,6 +67,10 @@ pub struct RayCamera {
     aperture: Option<Aperture>,
     clip_start: f32,
     clip_end: f32,
+    /// The camera's camera-to-world over the shutter, when it moves.
+    motion: Option<crate::motion::TransformMotion>,
+    /// Whether anything in the scene moves: each camera path then draws a shutter time.
+    scene_moves: bool,
 }
 
 impl RayCamera {
@@ -120,7 +124,34 @@ impl RayCamera {
             aperture: cam.aperture,
             clip_start: cam.clip_start,
             clip_end: cam.clip_end,
+            motion: scene.camera.and(scene.camera_motion.clone()),
+            scene_moves: scene.has_motion(),
         }
+    }
+
+    /// Whether camera paths need a shutter time (something in the scene moves): the caller
+    /// draws one only then, so scenes without motion consume no random number for it.
+    #[inline]
+    pub fn needs_time(&self) -> bool {
+        self.scene_moves
+    }
+
+    /// [`RayCamera::ray`] at shutter time `time`: from where a moving camera is then
+    /// (its transform interpolated as [`crate::motion`] describes).
+    #[inline]
+    pub fn ray_at(&self, film: Vec2, lens: Vec2, time: f32) -> Option<CameraRay> {
+        let Some(m) = &self.motion else {
+            return self.ray(film, lens);
+        };
+        let to_world = m.at(time);
+        let moved = RayCamera {
+            to_world,
+            origin: to_world.transform_point3(Vec3::ZERO),
+            forward: to_world.transform_vector3(-Vec3::Z).normalize(),
+            motion: None,
+            ..self.clone()
+        };
+        moved.ray(film, lens)
     }
 
     /// The camera's depth of world point `p`, as Cycles' Depth pass measures it: along the

@@ -6,8 +6,13 @@
 //! direction is not renormalised, so the ray parameter `t` means the same point in both spaces
 //! and the closest hit's `t` bounds the search in every later instance. Hits come back in world
 //! space: `p_w = M p_o`, the geometric normal through `M⁻ᵀ` (see [`crate::scene::instance`]).
+//!
+//! A moving instance ([`crate::motion`]) has its top-level bound around its whole path over
+//! the shutter, and a ray of time `time` enters it through the transform interpolated at
+//! that time.
 
 use crate::accel::{Accel, BRUTE_FORCE, Hit, Traversal, positive_zeros};
+use crate::motion::TransformMotion;
 use crate::scene::{Instance, Scene};
 use glam::{Affine3A, Mat3A, UVec2, Vec3, Vec3A};
 use obvhs::{
@@ -28,6 +33,28 @@ struct Placement {
     blas: u32,
     /// Index into [`Scene::instances`].
     instance: u32,
+    /// Index into [`InstanceAccel::motions`], or [`STILL`].
+    motion: u32,
+}
+
+/// [`Placement::motion`] of an instance that does not move.
+const STILL: u32 = u32::MAX;
+
+impl Placement {
+    /// The placement at shutter time `time`: itself when it does not move.
+    #[inline(always)]
+    fn at(&self, motions: &[std::sync::Arc<TransformMotion>], time: f32) -> Placement {
+        if self.motion == STILL {
+            return *self;
+        }
+        let to_world = motions[self.motion as usize].affine_at(time);
+        Placement {
+            from_world: to_world.inverse(),
+            to_world,
+            normal: to_world.matrix3.inverse().transpose(),
+            ..*self
+        }
+    }
 }
 
 /// The instances of a scene, ready for ray queries.
@@ -38,6 +65,8 @@ pub struct InstanceAccel {
     blas: Vec<Accel>,
     /// The mesh each bottom level was built from.
     blas_mesh: Vec<usize>,
+    /// The motions of the moving instances.
+    motions: Vec<std::sync::Arc<TransformMotion>>,
 }
 
 impl InstanceAccel {
@@ -76,6 +105,7 @@ impl InstanceAccel {
         let mut blas = Vec::new();
         let mut bounds = Vec::new();
         let mut placements = Vec::new();
+        let mut motions = Vec::new();
         for (ii, inst) in scene.instances.iter().enumerate() {
             let Some(mesh) = scene.meshes.get(inst.mesh) else {
                 continue;
@@ -101,18 +131,29 @@ impl InstanceAccel {
                     Accel::build_from(mesh.indices.len(), tris, keys)
                 }));
             }
-            let (lo, hi) = crate::scene::instance::transform_bounds(&inst.to_world, lo, hi);
+            let (lo, hi) = match &inst.motion {
+                Some(m) => m.bounds(lo, hi),
+                None => crate::scene::instance::transform_bounds(&inst.to_world, lo, hi),
+            };
             if !(lo.is_finite() && hi.is_finite()) {
                 continue;
             }
             let to_world = Affine3A::from_mat4(inst.to_world);
             bounds.push(Aabb::new(lo.into(), hi.into()));
+            let motion = match &inst.motion {
+                Some(m) => {
+                    motions.push(m.clone());
+                    motions.len() as u32 - 1
+                }
+                None => STILL,
+            };
             placements.push(Placement {
                 from_world: to_world.inverse(),
                 to_world,
                 normal: to_world.matrix3.inverse().transpose(),
                 blas: blas_of[inst.mesh],
                 instance: ii as u32,
+                motion,
             });
         }
         if placements.is_empty() {
@@ -133,6 +174,7 @@ impl InstanceAccel {
             placements,
             blas,
             blas_mesh,
+            motions,
         })
     }
 
@@ -153,8 +195,30 @@ impl InstanceAccel {
         self.placements.is_empty()
     }
 
+    /// Whether some instance moves over the shutter.
+    pub fn has_motion(&self) -> bool {
+        !self.motions.is_empty()
+    }
+
+    /// The world ray in placement `pl`'s object space at shutter time `time`.
+    #[inline(always)]
+    fn enter(&self, pl: &Placement, o: Vec3A, d: Vec3A, time: f32) -> (Vec3A, Vec3A) {
+        if pl.motion == STILL {
+            return (
+                pl.from_world.transform_point3a(o),
+                pl.from_world.transform_vector3a(d),
+            );
+        }
+        let from_world = self.motions[pl.motion as usize].affine_at(time).inverse();
+        (
+            from_world.transform_point3a(o),
+            from_world.transform_vector3a(d),
+        )
+    }
+
     /// The closest hit of placement `pl` along the world ray, object-space record.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn hit_in(
         &self,
         pl: &Placement,
@@ -163,11 +227,9 @@ impl InstanceAccel {
         d: Vec3A,
         tmin: f32,
         tmax: f32,
+        time: f32,
     ) -> Option<Hit> {
-        let (oo, dd) = (
-            pl.from_world.transform_point3a(o),
-            pl.from_world.transform_vector3a(d),
-        );
+        let (oo, dd) = self.enter(pl, o, d, time);
         self.blas[pl.blas as usize].intersect_with(bottom, oo.into(), dd.into(), tmin, tmax)
     }
 
@@ -180,9 +242,10 @@ impl InstanceAccel {
         h
     }
 
-    /// Closest hit of the world ray `o + t d` with `t` in `(tmin, tmax)`; `top` and `bottom`
-    /// are the two levels' traversal states.
+    /// Closest hit of the world ray `o + t d` with `t` in `(tmin, tmax)` at shutter time
+    /// `time`; `top` and `bottom` are the two levels' traversal states.
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     pub fn intersect_with(
         &self,
         top: &mut Traversal,
@@ -191,13 +254,14 @@ impl InstanceAccel {
         d: Vec3,
         tmin: f32,
         tmax: f32,
+        time: f32,
     ) -> Option<Hit> {
         let (oa, da) = (Vec3A::from(o), Vec3A::from(d));
         let mut best: Option<(Hit, usize)> = None;
         if self.placements.len() <= BRUTE_FORCE {
             let mut tmax = tmax;
             for (i, pl) in self.placements.iter().enumerate() {
-                if let Some(h) = self.hit_in(pl, bottom, oa, da, tmin, tmax) {
+                if let Some(h) = self.hit_in(pl, bottom, oa, da, tmin, tmax, time) {
                     tmax = h.t;
                     best = Some((h, i));
                 }
@@ -214,18 +278,27 @@ impl InstanceAccel {
                 {
                     let i = top.primitive_id as usize;
                     let pl = &self.placements[i];
-                    if let Some(h) = self.hit_in(pl, bottom, oa, da, ray.tmin, ray.tmax) {
+                    if let Some(h) = self.hit_in(pl, bottom, oa, da, ray.tmin, ray.tmax, time) {
                         ray.tmax = h.t;
                         best = Some((h, i));
                     }
                 }
             );
         }
-        best.map(|(h, i)| Self::to_world(&self.placements[i], h))
+        best.map(|(h, i)| {
+            let pl = &self.placements[i];
+            if pl.motion == STILL {
+                Self::to_world(pl, h)
+            } else {
+                Self::to_world(&pl.at(&self.motions, time), h)
+            }
+        })
     }
 
-    /// True when some instance's triangle lies on the ray with `t` in `(tmin, tmax)`.
+    /// True when some instance's triangle lies on the ray with `t` in `(tmin, tmax)` at
+    /// shutter time `time`.
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     pub fn occluded_with(
         &self,
         top: &mut Traversal,
@@ -234,13 +307,11 @@ impl InstanceAccel {
         d: Vec3,
         tmin: f32,
         tmax: f32,
+        time: f32,
     ) -> bool {
         let (oa, da) = (Vec3A::from(o), Vec3A::from(d));
         let blocks = |pl: &Placement, bottom: &mut Traversal| {
-            let (oo, dd) = (
-                pl.from_world.transform_point3a(oa),
-                pl.from_world.transform_vector3a(da),
-            );
+            let (oo, dd) = self.enter(pl, oa, da, time);
             self.blas[pl.blas as usize].occluded_with(bottom, oo.into(), dd.into(), tmin, tmax)
         };
         if self.placements.len() <= BRUTE_FORCE {
@@ -315,6 +386,7 @@ mod tests {
             );
             let t = Vec3::new(lcg(&mut state), lcg(&mut state), lcg(&mut state)) * 6.0;
             scene.instances.push(Instance {
+                motion: None,
                 mesh: 0,
                 to_world: Mat4::from_scale_rotation_translation(s, r, t),
                 material: None,
@@ -344,7 +416,7 @@ mod tests {
             } else {
                 8.0
             };
-            let a = two_level.intersect_with(&mut top, &mut bottom, o, d, 0.0, tmax);
+            let a = two_level.intersect_with(&mut top, &mut bottom, o, d, 0.0, tmax, 0.5);
             let b = flat.intersect(o, d, 0.0, tmax);
             match (a, b) {
                 (Some(a), Some(b)) => {
@@ -360,13 +432,100 @@ mod tests {
                 _ => mismatches += 1,
             }
             assert_eq!(
-                two_level.occluded_with(&mut top, &mut bottom, o, d, 0.0, tmax),
+                two_level.occluded_with(&mut top, &mut bottom, o, d, 0.0, tmax, 0.5),
                 a.is_some(),
                 "occlusion agrees with the closest hit"
             );
         }
         assert!(mismatches <= 5, "{mismatches} rays disagree");
         assert!(hits > 2000, "{hits} hits");
+    }
+
+    /// A unit box moving along +x from x = -3 at time 0 to x = +3 at time 1 (and a still box
+    /// far away, so the traversal has a top level to go through): a ray down -z at x = c
+    /// meets it only at the times when the box covers c, with the box's top at z = 0.5.
+    fn moving_box_hit_at_the_right_times(extra_still: usize) {
+        let mut state = 7u64;
+        let mut cube = blob(&mut state);
+        // An axis-aligned cube of side 1 around the origin, as 12 triangles.
+        let c = |x: f32, y: f32, z: f32| Vec3::new(x - 0.5, y - 0.5, z - 0.5);
+        cube.positions = (0..8)
+            .map(|k| c((k & 1) as f32, ((k >> 1) & 1) as f32, ((k >> 2) & 1) as f32))
+            .collect();
+        cube.indices = vec![
+            [0, 1, 3],
+            [0, 3, 2],
+            [4, 6, 7],
+            [4, 7, 5],
+            [0, 4, 5],
+            [0, 5, 1],
+            [2, 3, 7],
+            [2, 7, 6],
+            [0, 2, 6],
+            [0, 6, 4],
+            [1, 5, 7],
+            [1, 7, 3],
+        ];
+        let keys = [
+            (0.0, Mat4::from_translation(Vec3::new(-3.0, 0.0, 0.0))),
+            (0.5, Mat4::IDENTITY),
+            (1.0, Mat4::from_translation(Vec3::new(3.0, 0.0, 0.0))),
+        ];
+        let motion = std::sync::Arc::new(TransformMotion::new(&keys).unwrap());
+        let mut scene = Scene {
+            meshes: vec![cube],
+            ..Default::default()
+        };
+        scene.instances.push(Instance {
+            motion: Some(motion),
+            mesh: 0,
+            to_world: Mat4::IDENTITY,
+            material: None,
+            object: ObjectInfo::default(),
+        });
+        for k in 0..extra_still {
+            scene.instances.push(Instance {
+                motion: None,
+                mesh: 0,
+                to_world: Mat4::from_translation(Vec3::new(50.0 + 2.0 * k as f32, 0.0, 0.0)),
+                material: None,
+                object: ObjectInfo::default(),
+            });
+        }
+        let accel = InstanceAccel::new(&scene, |_| true).unwrap();
+        assert!(accel.has_motion());
+        let (mut top, mut bottom) = (Traversal::default(), Traversal::default());
+        let d = Vec3::new(0.0, 0.0, -1.0);
+        for xi in -6..=6 {
+            let x = xi as f32 * 0.5 + 0.01;
+            let o = Vec3::new(x, 0.1, 5.0);
+            for ti in 0..=100 {
+                let time = ti as f32 / 100.0;
+                let centre = -3.0 + 6.0 * time;
+                let want = (x - centre).abs() < 0.5;
+                // Grazing the box's sides is left out.
+                if ((x - centre).abs() - 0.5).abs() < 1e-3 {
+                    continue;
+                }
+                let hit = accel.intersect_with(&mut top, &mut bottom, o, d, 0.0, 100.0, time);
+                assert_eq!(hit.is_some(), want, "x {x} time {time}");
+                if let Some(h) = hit {
+                    assert!(
+                        (h.t - 4.5).abs() < 1e-4 && (h.p.z - 0.5).abs() < 1e-4,
+                        "{h:?}"
+                    );
+                    assert!(h.ng.normalize().dot(Vec3::Z).abs() > 0.999);
+                }
+                let blocked = accel.occluded_with(&mut top, &mut bottom, o, d, 0.0, 100.0, time);
+                assert_eq!(blocked, want, "occlusion at x {x} time {time}");
+            }
+        }
+    }
+
+    #[test]
+    fn moving_box_is_hit_only_at_the_right_times() {
+        moving_box_hit_at_the_right_times(0);
+        moving_box_hit_at_the_right_times(BRUTE_FORCE + 4);
     }
 
     #[test]

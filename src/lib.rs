@@ -15,6 +15,7 @@ pub mod frame;
 pub mod instancing;
 pub mod integrator;
 pub mod medium;
+pub mod motion;
 pub mod output;
 pub mod protocol;
 pub mod render;

@@ -331,6 +331,7 @@ fn render_samples(
     let pixel_index = py as u64 * opts.width as u64 + px as u64;
     let transparent = scene.scene.settings.film_transparent;
     let lens = camera.has_lens();
+    let timed = camera.needs_time();
     let adaptive = opts.adaptive.is_some();
     let light = data.is_some_and(|d| d.passes.has_light());
     let catcher = data.and_then(|d| d.passes.offset(Pass::CatcherSums));
@@ -344,7 +345,8 @@ fn render_samples(
     for s in acc.next..end {
         ctx.sampler = sampler(s);
         // Dimension 0: the pixel filter (with the first BSDF sample reserved, see
-        // `next_2d_reserving`); 1: the lens, only for cameras with depth of field.
+        // `next_2d_reserving`); then the lens, only for cameras with depth of field; then the
+        // shutter time, only in scenes where something moves.
         let u = ctx.sampler.next_2d_reserving();
         let film = Vec2::new(
             px as f32 + opts.filter.offset(u.x),
@@ -355,7 +357,13 @@ fn render_samples(
         } else {
             Vec2::ZERO
         };
-        let Some(ray) = camera.ray(film, u_lens) else {
+        let ray = if timed {
+            ctx.time = ctx.sampler.next_1d();
+            camera.ray_at(film, u_lens, ctx.time)
+        } else {
+            camera.ray(film, u_lens)
+        };
+        let Some(ray) = ray else {
             acc.empty += 1;
             continue;
         };
@@ -397,6 +405,9 @@ fn render_samples(
                         ctx.sampler.next_2d_reserving();
                         if lens {
                             ctx.sampler.next_2d();
+                        }
+                        if timed {
+                            ctx.sampler.next_1d();
                         }
                         (ctx.catchers_only, ctx.camera_hit) = (true, None);
                         let k = integrator.li(scene, ctx, ray.o, ray.d);

@@ -46,6 +46,8 @@ pub struct Intersection {
     pub material: u32,
     /// Index into [`RenderScene::emitters`] if the surface emits.
     pub emitter: Option<u32>,
+    /// The shutter time of the ray that found it (motion blur).
+    pub time: f32,
 }
 
 impl Intersection {
@@ -137,10 +139,10 @@ impl crate::shading::globals::Tracer for RenderScene {
         let o = offset_origin(from_blender(g.p), from_blender(g.ng), d);
         if !only_local {
             let (mut trav, mut top) = (Traversal::default(), Traversal::default());
-            return self.occluded_with(&mut trav, &mut top, o, d, tmax);
+            return self.occluded_with(&mut trav, &mut top, o, d, tmax, g.time);
         }
         let mut found = false;
-        self.each_local_hit(g.object, o, d, tmax, MAX_LOCAL_SKIPS, |_| {
+        self.each_local_hit(g.object, o, d, tmax, MAX_LOCAL_SKIPS, g.time, |_| {
             found = true;
             false
         });
@@ -163,8 +165,8 @@ impl crate::shading::globals::Tracer for RenderScene {
         let mut n = 0;
         // Other objects' surfaces count towards the steps too: a bounded walk.
         let steps = hits.len() as u32 + MAX_LOCAL_SKIPS;
-        self.each_local_hit(g.object, o, d, tmax, steps, |hit| {
-            let its = self.intersection(hit, d);
+        self.each_local_hit(g.object, o, d, tmax, steps, g.time, |hit| {
+            let its = self.intersection(hit, d, g.time);
             hits[n] = LocalHit {
                 p: to_blender(its.p),
                 n: to_blender(its.ns),
@@ -236,6 +238,9 @@ pub struct Ctx {
     /// The path is a shadow catcher's second path ([`crate::film::catcher`]): every ray it
     /// casts sees the shadow catchers alone, as Cycles' catcher-pass paths do.
     pub catchers_only: bool,
+    /// The path's shutter time in `[0, 1)` (motion blur): every ray of the path sees the
+    /// scene as it is then. 0.5 in scenes without motion, where nothing reads it.
+    pub time: f32,
 }
 
 /// A path vertex's index and the path's bounces of each kind before it: what an emitter's
@@ -279,6 +284,7 @@ impl Ctx {
             camera_memo: false,
             camera_hit: None,
             catchers_only: false,
+            time: 0.5,
         }
     }
 
@@ -697,7 +703,13 @@ impl RenderScene {
     /// Builds the BVH and the emitters. Emissive meshes of zero area are skipped with a warning.
     pub fn new(mut scene: Scene, choice: LightChoice) -> RenderScene {
         let (programs, mut warnings) = compile_programs(&scene);
-        bake_emissive_instances(&mut scene, &programs);
+        if bake_emissive_instances(&mut scene, &programs) {
+            warnings.push(
+                "an emissive mesh moves over the shutter: emitters are not motion blurred; it \
+                 renders at its frame transform"
+                    .into(),
+            );
+        }
         let to_world = blender_camera_to_world(&scene);
         for w in crate::displace::displace_meshes(&mut scene, to_world) {
             if !warnings.contains(&w) {
@@ -1161,7 +1173,7 @@ impl RenderScene {
             let kind = bounce_visibility(ctx.ray_flags) | ctx.catcher_kind();
             self.closest_seen(ctx, o, d, f32::INFINITY, kind, LightLinks::ALL)?
         };
-        Some(self.intersection(&hit, d))
+        Some(self.intersection(&hit, d, ctx.time))
     }
 
     /// Whether some object is hidden from rays that closures scatter (diffuse, glossy or
@@ -1273,11 +1285,13 @@ impl RenderScene {
     /// [`Self::closest`] in `(tmin, tmax)`.
     #[inline(always)]
     fn closest_after(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.closest_with(&mut ctx.trav, &mut ctx.trav_top, o, d, tmin, tmax)
+        self.closest_with(&mut ctx.trav, &mut ctx.trav_top, o, d, tmin, tmax, ctx.time)
     }
 
-    /// [`Self::closest_after`] on the given traversal states (bottom level, top level).
+    /// [`Self::closest_after`] on the given traversal states (bottom level, top level), at
+    /// shutter time `time`.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn closest_with(
         &self,
         trav: &mut Traversal,
@@ -1286,13 +1300,14 @@ impl RenderScene {
         d: Vec3,
         tmin: f32,
         tmax: f32,
+        time: f32,
     ) -> Option<Hit> {
         let hit = self.accel.intersect_with(trav, o, d, tmin, tmax);
         let Some(inst) = &self.instances else {
             return hit;
         };
         let t = hit.map_or(tmax, |h| h.t);
-        inst.intersect_with(top, trav, o, d, tmin, t).or(hit)
+        inst.intersect_with(top, trav, o, d, tmin, t, time).or(hit)
     }
 
     /// The closest surface of one object — mesh `mesh` placed by `instance` — along the unit
@@ -1315,7 +1330,7 @@ impl RenderScene {
             ctx.cast(o, d, tmax, RayKind::Closest);
             let hit = self.closest_after(ctx, o, d, tmin, tmax)?;
             if hit.key[0] == mesh && hit.instance == instance {
-                return Some(self.intersection(&hit, d));
+                return Some(self.intersection(&hit, d, ctx.time));
             }
             tmin = hit.t;
         }
@@ -1325,10 +1340,11 @@ impl RenderScene {
     /// Whether anything lies on the ray in `(0, tmax)`.
     #[inline(always)]
     fn occluded(&self, ctx: &mut Ctx, o: Vec3, d: Vec3, tmax: f32) -> bool {
-        self.occluded_with(&mut ctx.trav, &mut ctx.trav_top, o, d, tmax)
+        self.occluded_with(&mut ctx.trav, &mut ctx.trav_top, o, d, tmax, ctx.time)
     }
 
-    /// [`Self::occluded`] on the given traversal states (bottom level, top level).
+    /// [`Self::occluded`] on the given traversal states (bottom level, top level), at
+    /// shutter time `time`.
     #[inline(always)]
     fn occluded_with(
         &self,
@@ -1337,15 +1353,17 @@ impl RenderScene {
         o: Vec3,
         d: Vec3,
         tmax: f32,
+        time: f32,
     ) -> bool {
         self.accel.occluded_with(trav, o, d, 0.0, tmax)
             || (self.instances.as_ref())
-                .is_some_and(|inst| inst.occluded_with(top, trav, o, d, 0.0, tmax))
+                .is_some_and(|inst| inst.occluded_with(top, trav, o, d, 0.0, tmax, time))
     }
 
     /// Walks the surfaces on the ray `o + t d` (renderer space, `t` in `(0, tmax)`) nearest
     /// first, at most `steps` of them of any object, calling `visit` on those of `object`
-    /// (`[mesh, instance]`) until it returns false.
+    /// (`[mesh, instance]`) until it returns false; at shutter time `time`.
+    #[allow(clippy::too_many_arguments)]
     fn each_local_hit(
         &self,
         object: [u32; 2],
@@ -1353,12 +1371,13 @@ impl RenderScene {
         d: Vec3,
         tmax: f32,
         steps: u32,
+        time: f32,
         mut visit: impl FnMut(&Hit) -> bool,
     ) {
         let (mut trav, mut top) = (Traversal::default(), Traversal::default());
         let mut tmin = 0.0;
         for _ in 0..steps {
-            let Some(hit) = self.closest_with(&mut trav, &mut top, o, d, tmin, tmax) else {
+            let Some(hit) = self.closest_with(&mut trav, &mut top, o, d, tmin, tmax, time) else {
                 return;
             };
             tmin = hit.t;
@@ -1388,7 +1407,7 @@ impl RenderScene {
         };
         ctx.cast(o, d, f32::INFINITY, RayKind::Emission);
         if let Some(hit) = emissive.intersect_with(&mut ctx.trav, o, d, 0.0, f32::INFINITY) {
-            let its = self.intersection(&hit, d);
+            let its = self.intersection(&hit, d, ctx.time);
             let (e, le, rec) = self.emitted(&its, o, ctx.ray_flags, ctx.path_at(), ctx.receiver)?;
             if le == Vec3::ZERO {
                 return None;
@@ -1529,7 +1548,7 @@ impl RenderScene {
             let Some(hit) = self.closest_shadowing(ctx, o, d, tmax, blockers) else {
                 return tr * medium::transmittance(m.sigma_t(), tmax);
             };
-            let its = self.intersection(&hit, d);
+            let its = self.intersection(&hit, d, ctx.time);
             tr *= self.transparency(ctx, &its, d);
             if tr == Vec3::ZERO {
                 return tr;
@@ -1551,7 +1570,7 @@ impl RenderScene {
 
     /// The full intersection record of `hit` (a hit of a ray along `d`).
     #[inline]
-    fn intersection(&self, hit: &Hit, d: Vec3) -> Intersection {
+    fn intersection(&self, hit: &Hit, d: Vec3, time: f32) -> Intersection {
         let [mi, ti] = hit.key;
         let mesh = &self.scene.meshes[mi as usize];
         let (b1, b2) = (hit.u, hit.v);
@@ -1569,7 +1588,7 @@ impl RenderScene {
             let inst = &self.scene.instances[hit.instance as usize];
             let ns = mesh
                 .interpolate(&mesh.normals, ti, b1, b2)
-                .and_then(|n| (inst.normal_matrix() * n).try_normalize())
+                .and_then(|n| (inst.normal_matrix_at(time) * n).try_normalize())
                 .unwrap_or(ng);
             (ns, inst.material.unwrap_or(mesh.material))
         };
@@ -1594,6 +1613,7 @@ impl RenderScene {
             b2,
             material: material as u32,
             emitter: self.mesh_emitter[mi as usize],
+            time,
         }
     }
 
@@ -1619,7 +1639,7 @@ impl RenderScene {
             let kind = ray::CAMERA | ctx.catcher_kind();
             self.closest_seen(ctx, o, d, tmax, kind, LightLinks::ALL)
         };
-        let its = hit.map(|h| self.intersection(&h, d));
+        let its = hit.map(|h| self.intersection(&h, d, ctx.time));
         if ctx.camera_memo {
             ctx.camera_hit = Some((o, d, tmax, its));
         }
@@ -1701,6 +1721,7 @@ impl RenderScene {
             ray_flags: flags,
             object: [its.mesh, its.instance],
             seed: point_seed(its.p),
+            time: its.time,
         }
     }
 
@@ -1974,8 +1995,9 @@ impl RenderScene {
 }
 
 /// Replaces each instance whose material may emit by a world-space copy of its mesh, so
-/// that area emitters sample the instance's own triangles (areas under its scale).
-fn bake_emissive_instances(scene: &mut Scene, programs: &[Arc<Program>]) {
+/// that area emitters sample the instance's own triangles (areas under its scale). Returns
+/// whether a moving instance was baked (at its frame transform: its motion is dropped).
+fn bake_emissive_instances(scene: &mut Scene, programs: &[Arc<Program>]) -> bool {
     let emits = |scene: &Scene, i: &crate::scene::Instance| {
         let Some(mesh) = scene.meshes.get(i.mesh) else {
             return false;
@@ -1984,12 +2006,14 @@ fn bake_emissive_instances(scene: &mut Scene, programs: &[Arc<Program>]) {
         programs.get(m).is_some_and(|p| p.may_emit())
     };
     if !scene.instances.iter().any(|i| emits(scene, i)) {
-        return;
+        return false;
     }
+    let mut dropped_motion = false;
     let was_placed = scene.placed_meshes();
     let instances = std::mem::take(&mut scene.instances);
     for inst in instances {
         if emits(scene, &inst) {
+            dropped_motion |= inst.motion.is_some();
             let baked = scene.meshes[inst.mesh].placed(&inst);
             scene.meshes.push(baked);
         } else {
@@ -2005,6 +2029,7 @@ fn bake_emissive_instances(scene: &mut Scene, programs: &[Arc<Program>]) {
             m.positions = Vec::new();
         }
     }
+    dropped_motion
 }
 
 /// Where emitter `e` emits from and in which directions, for a light tree; `None` for

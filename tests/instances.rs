@@ -46,6 +46,7 @@ fn instanced() -> Scene {
         .meshes
         .push(sphere("ball", white, Vec3::ZERO, 1.0, 12, 24));
     let place = |s: Vec3, r: Quat, t: Vec3, material| Instance {
+        motion: None,
         mesh: ball,
         to_world: Mat4::from_scale_rotation_translation(s, r, t),
         material,
@@ -237,6 +238,7 @@ fn shading_reads_the_same_through_an_instance_as_baked() {
         ..Default::default()
     };
     let inst = Instance {
+        motion: None,
         mesh: 0,
         to_world: Mat4::from_scale_rotation_translation(
             Vec3::new(-2.0, 0.5, 1.5),
@@ -303,6 +305,7 @@ fn instances_that_cannot_be_drawn_are_left_out_without_a_panic() {
         Mat4::from_translation(Vec3::NAN),
     ] {
         scene.instances.push(Instance {
+            motion: None,
             to_world,
             ..bad.clone()
         });

@@ -1158,6 +1158,7 @@ mod tests {
             b2: 0.0,
             material: 0,
             emitter: None,
+            time: 0.5,
         };
         (sp, its, d)
     }

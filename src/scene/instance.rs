@@ -24,6 +24,10 @@ pub struct Instance {
     pub material: Option<usize>,
     /// Blender's Object Info of this instance (its own random number and location).
     pub object: ObjectInfo,
+    /// Object → world over the shutter (motion blur), or `None` for a still instance
+    /// (`to_world` is then its transform at every time). A moving instance's `to_world` is
+    /// its transform at the frame's instant, which shading reads.
+    pub motion: Option<std::sync::Arc<crate::motion::TransformMotion>>,
 }
 
 impl Instance {
@@ -45,6 +49,24 @@ impl Instance {
     /// The matrix normals go through (inverse transpose of the linear part).
     pub fn normal_matrix(&self) -> Mat3 {
         Mat3::from_mat4(self.to_world).inverse().transpose()
+    }
+
+    /// Object → world at shutter time `time` (see [`crate::motion`]).
+    #[inline]
+    pub fn to_world_at(&self, time: f32) -> Mat4 {
+        match &self.motion {
+            Some(m) => m.at(time),
+            None => self.to_world,
+        }
+    }
+
+    /// [`Instance::normal_matrix`] at shutter time `time`.
+    #[inline]
+    pub fn normal_matrix_at(&self, time: f32) -> Mat3 {
+        match &self.motion {
+            Some(m) => Mat3::from_mat4(m.at(time)).inverse().transpose(),
+            None => self.normal_matrix(),
+        }
     }
 
     /// Whether the transform mirrors (negative determinant).
@@ -158,6 +180,7 @@ mod tests {
             ..Default::default()
         };
         let inst = Instance {
+            motion: None,
             mesh: 0,
             to_world: Mat4::from_scale(Vec3::new(-2.0, 1.0, 1.0)),
             material: None,

@@ -923,6 +923,9 @@ pub struct Scene {
     /// The light and shadow linking of each of `lights` (missing entries: none).
     pub light_links: Vec<LightLinks>,
     pub camera: Option<Camera>,
+    /// The camera's camera-to-world over the shutter (motion blur; rigid keys), or `None`
+    /// for a camera that stays at `camera.to_world`.
+    pub camera_motion: Option<crate::motion::TransformMotion>,
     /// Constant background radiance seen by rays that leave the scene, W/(m² sr).
     pub background: Vec3,
     /// The world's node graph and settings (the constant `background` is its fallback).
@@ -933,6 +936,11 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// Whether anything moves over the shutter (then each camera path draws a time).
+    pub fn has_motion(&self) -> bool {
+        self.camera_motion.is_some() || self.instances.iter().any(|i| i.motion.is_some())
+    }
+
     /// Axis-aligned world-space bounds of all geometry (instances by their transformed mesh
     /// bounds), or `None` for a scene without geometry.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
@@ -952,7 +960,10 @@ impl Scene {
             .collect();
         for inst in &self.instances {
             if let Some(Some((l, h))) = mesh_bounds.get(inst.mesh) {
-                let (l, h) = instance::transform_bounds(&inst.to_world, *l, *h);
+                let (l, h) = match &inst.motion {
+                    Some(m) => m.bounds(*l, *h),
+                    None => instance::transform_bounds(&inst.to_world, *l, *h),
+                };
                 lo = lo.min(l);
                 hi = hi.max(h);
                 any = true;

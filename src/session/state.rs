@@ -326,6 +326,7 @@ impl Loaded {
             let mut object = m.attrs.object.clone();
             object.location = location;
             self.source.instances.push(Instance {
+                motion: None,
                 mesh: mi,
                 to_world: delta,
                 material: None,
@@ -663,6 +664,7 @@ impl Loaded {
             }
             if let Some(object) = object {
                 let inst = Instance {
+                    motion: None,
                     mesh: 0,
                     to_world: world,
                     material: None,
@@ -702,6 +704,7 @@ impl Loaded {
             for (n, p) in placements {
                 for k in 0..new_meshes.len() {
                     kept.push(Instance {
+                        motion: None,
                         mesh: first + k,
                         material: None,
                         ..p.clone()

@@ -119,6 +119,8 @@ pub struct ShaderGlobals<'a> {
     /// Scrambles the random numbers of the rays the program casts at this point; kept by the
     /// Bump node's offset points so their rays agree.
     pub seed: u32,
+    /// The path's shutter time (motion blur): where a moving instance is.
+    pub time: f32,
 }
 
 /// Bounces of each kind a path has made before the current vertex, as Cycles' path state
@@ -157,6 +159,7 @@ impl<'a> ShaderGlobals<'a> {
             ray_flags: ray::CAMERA,
             object: [u32::MAX; 2],
             seed: 0,
+            time: 0.5,
         }
     }
 
@@ -230,7 +233,7 @@ impl<'a> ShaderGlobals<'a> {
     #[inline(always)]
     fn mesh_to_world(&self, v: Vec3) -> Vec3 {
         match self.instance {
-            Some(i) => i.to_world.transform_vector3(v),
+            Some(i) => i.to_world_at(self.time).transform_vector3(v),
             None => v,
         }
     }
@@ -242,7 +245,7 @@ impl<'a> ShaderGlobals<'a> {
         let corners = m.corners(self.tri).map(|i| m.positions[i]);
         Some(corners.map(|p| {
             to_blender(match self.instance {
-                Some(i) => i.to_world.transform_point3(p),
+                Some(i) => i.to_world_at(self.time).transform_point3(p),
                 None => p,
             })
         }))
@@ -254,7 +257,7 @@ impl<'a> ShaderGlobals<'a> {
     pub fn to_object(&self) -> Option<Mat4> {
         let m = self.mesh?;
         Some(match self.instance {
-            Some(i) => m.attrs.to_object * i.to_world.inverse(),
+            Some(i) => m.attrs.to_object * i.to_world_at(self.time).inverse(),
             None => m.attrs.to_object,
         })
     }

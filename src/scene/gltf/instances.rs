@@ -12,6 +12,7 @@ use json::accessor::Type;
 use std::collections::HashMap;
 
 use super::{LoadError, LoadErrorKind, Loader, extension, invalid, json, member};
+use crate::motion::TransformMotion;
 use crate::scene::{Instance, instance::transform_bounds};
 
 /// Most instances a file may place (about 0.5 GB of instance and BVH data).
@@ -27,6 +28,8 @@ pub(crate) struct MeshUse {
     /// The add-on's `_TESELA_RANDOM` attribute: each instance's Object Info random (may be
     /// empty: then a hash of node and instance index).
     pub gpu_random: Vec<f32>,
+    /// The node's world keys over the shutter (`TESELA_motion`), `None` when it stays still.
+    pub motion: Option<Vec<(f32, Mat4)>>,
 }
 
 impl<'a> Loader<'a> {
@@ -145,6 +148,12 @@ impl<'a> Loader<'a> {
             // A skinned mesh is posed by its joints, in world space, whatever its node says.
             let skinning = self.skinning(u.node, u.world)?;
             if let Some(s) = &skinning {
+                if u.motion.is_some() {
+                    self.warn_once(format!(
+                        "node {}: the motion of a skinned mesh is not rendered; it renders posed by its skin",
+                        u.node
+                    ));
+                }
                 if !u.gpu.is_empty() {
                     self.warn_once(format!(
                         "node {}: a skinned mesh placed by EXT_mesh_gpu_instancing is drawn once, posed by its skin",
@@ -158,7 +167,11 @@ impl<'a> Loader<'a> {
                 origins.resize(baked.end, Some(u.node));
                 continue;
             }
-            if u.gpu.is_empty() && (placements[&g] == 1 || own_weights || small) {
+            // A moving mesh is placed by an instance, whose transform follows the time.
+            if u.gpu.is_empty()
+                && u.motion.is_none()
+                && (placements[&g] == 1 || own_weights || small)
+            {
                 let (baked, _) = self.instance_mesh(u.node, u.mesh, u.world, false, None)?;
                 let origins = &mut self.origins.mesh_node;
                 origins.resize(baked.start, None);
@@ -196,15 +209,26 @@ impl<'a> Loader<'a> {
             let (mut skipped, mut why) = (0usize, "");
             for (k, local) in locals.iter().enumerate() {
                 let world = u.world * *local;
-                let problem = Instance::check(&world).or_else(|| {
-                    (range.clone())
-                        .filter_map(|mi| self.scene.meshes[mi].bounds())
-                        .map(|(lo, hi)| transform_bounds(&world, lo, hi))
-                        .any(|(lo, hi)| {
-                            lo.abs().max(hi.abs()).max_element() > crate::accel::MAX_COORD
+                let keys: Option<Vec<(f32, Mat4)>> = (u.motion.as_ref())
+                    .map(|keys| keys.iter().map(|(t, m)| (*t, *m * *local)).collect());
+                let motion = keys.as_ref().and_then(|k| TransformMotion::new(k).ok());
+                let problem = Instance::check(&world)
+                    .or_else(|| {
+                        let bad = keys.iter().flatten().find_map(|(_, m)| Instance::check(m));
+                        bad.or_else(|| {
+                            (keys.is_some() && motion.is_none())
+                                .then_some("its motion keys are not valid")
                         })
-                        .then_some("it reaches beyond the renderer's coordinate limit")
-                });
+                    })
+                    .or_else(|| {
+                        (range.clone())
+                            .filter_map(|mi| self.scene.meshes[mi].bounds())
+                            .map(|(lo, hi)| transform_bounds(&world, lo, hi))
+                            .any(|(lo, hi)| {
+                                lo.abs().max(hi.abs()).max_element() > crate::accel::MAX_COORD
+                            })
+                            .then_some("it reaches beyond the renderer's coordinate limit")
+                    });
                 if let Some(p) = problem {
                     skipped += 1;
                     why = p;
@@ -217,9 +241,11 @@ impl<'a> Loader<'a> {
                         _ => instance_random(u.node, k),
                     };
                 }
+                let motion = motion.map(std::sync::Arc::new);
                 for (k, mesh) in range.clone().enumerate() {
                     self.origins.instance_node.push(u.node);
                     self.scene.instances.push(Instance {
+                        motion: motion.clone(),
                         mesh,
                         to_world: world,
                         material: materials.as_ref().map(|m| m[k]),

@@ -24,6 +24,7 @@ mod linking;
 mod material;
 mod mesh;
 mod meshopt;
+mod motion;
 mod points;
 mod skin;
 mod tangents;
@@ -84,6 +85,7 @@ const SUPPORTED_REQUIRED: &[&str] = &[
     "TESELA_images",
     "TESELA_camera",
     "TESELA_light_linking",
+    "TESELA_motion",
 ];
 
 /// Extensions that are used without a warning. Clearcoat, sheen and anisotropy reach the
@@ -118,6 +120,7 @@ const UNDERSTOOD: &[&str] = &[
     "TESELA_images",
     "TESELA_camera",
     "TESELA_light_linking",
+    "TESELA_motion",
 ];
 
 /// Loads a `.gltf` or `.glb` file. External files are resolved relative to its folder
@@ -634,10 +637,16 @@ impl<'a> Loader<'a> {
                     "node {ni}: its world transform is not finite"
                 )));
             }
+            let motion = self.node_motion(ni, parent)?;
+            let mut moved = false;
             if let Some(ci) = node.camera
                 && self.scene.camera.is_none()
             {
                 self.scene.camera = Some(self.camera(ci.value(), ni, world)?);
+                if let Some(keys) = &motion {
+                    self.scene.camera_motion = Some(self.camera_motion(ni, keys)?);
+                    moved = true;
+                }
             }
             if let Some(mi) = node.mesh {
                 let mi = mi.value();
@@ -648,13 +657,21 @@ impl<'a> Loader<'a> {
                     )));
                 }
                 let (gpu, gpu_random) = self.gpu_instances(ni)?;
+                moved |= motion.is_some();
                 uses.push(instances::MeshUse {
                     node: ni,
                     mesh: mi,
                     world,
                     gpu,
                     gpu_random,
+                    motion: motion.clone(),
                 });
+            }
+            if motion.is_some() && !moved {
+                self.warn_once(format!(
+                    "node {ni}: its motion (TESELA_motion) is rendered for meshes and cameras \
+                     only; it renders at its node transform"
+                ));
             }
             self.node_curves(ni, world)?;
             self.node_points(ni, world)?;
