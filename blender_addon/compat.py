@@ -965,3 +965,27 @@ def frame_final(scene):
     """The scene's current frame with its subframe (what a particle's age is counted to)."""
     final = getattr(scene, "frame_current_final", None)
     return float(scene.frame_current if final is None else final)
+
+
+def motion_blur_position(scene):
+    """Motion Blur > Position ('START', 'CENTER', 'END'): the render settings' since Blender
+    4.x, Cycles' scene settings before."""
+    position = getattr(scene.render, "motion_blur_position", None)
+    if position is None:
+        position = getattr(getattr(scene, "cycles", None), "motion_blur_position", "CENTER")
+    return position
+
+
+def rolling_shutter_type(scene):
+    """Cycles' rolling shutter type ('NONE', 'TOP'), or None without Cycles' settings."""
+    return getattr(getattr(scene, "cycles", None), "rolling_shutter_type", None)
+
+
+def shutter_curve_is_flat(render):
+    """Whether the Motion Blur > Shutter Curve is flat (Cycles' default: the shutter is open
+    evenly over its interval)."""
+    curve = getattr(render, "motion_blur_shutter_curve", None)
+    if curve is None or not len(curve.curves):
+        return True
+    ys = [p.location[1] for p in curve.curves[0].points]
+    return not ys or max(ys) - min(ys) <= 1e-6

@@ -294,9 +294,13 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
                            "integrator": settings.integrator}
         t0 = time.monotonic()
         try:
-            res = export.write_gltf(depsgraph, gltf, width=width, height=height, camera=camera,
-                                    render_settings=render_settings, check_cancel=self.should_stop,
-                                    mesh_store=store)
+            # With motion blur, the scene is sampled over the shutter and exported at its
+            # centre; the frame is restored when the export ends.
+            with export.motion.sampled(self, depsgraph, camera) as motion:
+                res = export.write_gltf(depsgraph, gltf, width=width, height=height,
+                                        camera=camera, render_settings=render_settings,
+                                        check_cancel=self.should_stop, mesh_store=store,
+                                        motion=motion)
         except export.ExportCancelled:
             return
         if store is not None:

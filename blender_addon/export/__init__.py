@@ -12,10 +12,11 @@ and the fallback PNGs), light, world, camera; gltf assembles the document, buffe
 if "gltf" in locals():  # reload support (F3 > Reload Scripts): submodules first
     import importlib
     for _m in (common, buffer, images, material, mesh, mesh_store, light, camera, world,  # noqa: F821
-               gltf):  # noqa: F821
+               motion, gltf):  # noqa: F821
         importlib.reload(_m)
 
 from . import common, buffer, images, material, mesh, mesh_store, light, camera, world  # noqa: E402,F401
+from . import motion  # noqa: E402,F401
 from . import gltf  # noqa: E402,F401
 from .buffer import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT, UINT, Buffer  # noqa: E402,F401
 from .camera import camera_extension, camera_fields, camera_matrix  # noqa: E402,F401

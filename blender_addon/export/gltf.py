@@ -70,7 +70,7 @@ def _rendered_hair(obj):
 
 
 def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settings=None,
-               check_cancel=None, selection=None, mesh_store=None):
+               check_cancel=None, selection=None, mesh_store=None, motion=None):
     """Write the evaluated scene of `depsgraph` to `filepath` (.gltf) + a .bin beside it.
 
     width/height: the final render resolution (percentage applied).
@@ -80,6 +80,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     selection: optional set of original object names to restrict the export.
     mesh_store: a MeshStore whose folder holds `filepath`: the meshes' buffers go to its files,
     one per mesh content, written only where no earlier export wrote them (animations).
+    motion: a motion.Motion sampled over the shutter (motion blur), or None.
     """
     res = ExportResult()
     warnings = res.warnings
@@ -316,11 +317,18 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             extras = {"tesela_object": tesela_object(inst, obj)}
             if texspace is not None:
                 extras["tesela_texspace"] = {"location": texspace[0], "size": texspace[1]}
+            node = {"name": obj.name, "mesh": mi,
+                    "matrix": gltf_matrix(matrix(inst.matrix_world)), "extras": extras}
+            keys = motion.node_extension(inst) if motion is not None else None
+            if keys is not None:
+                node["extensions"] = {"TESELA_motion": keys}
+                used_ext.add("TESELA_motion")
             mesh_nodes.setdefault(mi, []).append(len(doc["nodes"]))
-            linked_node({"name": obj.name, "mesh": mi,
-                         "matrix": gltf_matrix(matrix(inst.matrix_world)), "extras": extras},
-                        obj, inst)
+            linked_node(node, obj, inst)
         elif otype == "CURVES":
+            if motion is not None and motion.moves(inst):
+                warnings.append("curves '%s' move over the shutter: their motion blur is not "
+                                "rendered; they render at the shutter's centre" % obj.name)
             slots = [s.material for s in obj.material_slots] or list(obj.data.materials)
             ext = curves_extension(obj.data, slot_materials(slots), buf)
             if ext is not None:
@@ -329,6 +337,9 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
                              "extensions": {"TESELA_curves": ext},
                              "extras": {"tesela_object": tesela_object(inst, obj)}}, obj, inst)
         elif otype == "POINTCLOUD":
+            if motion is not None and motion.moves(inst):
+                warnings.append("points '%s' move over the shutter: their motion blur is not "
+                                "rendered; they render at the shutter's centre" % obj.name)
             slots = [s.material for s in obj.material_slots] or list(obj.data.materials)
             first = slot_materials(slots[:1])
             ext = points_extension(obj.data, first[0] if first else None,
@@ -349,6 +360,10 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             warnings.append("light '%s' is a portal: left out (Cycles uses portals only to "
                             "sample the world; Tesela samples it without them)" % obj.name)
         elif otype == "LIGHT":
+            if motion is not None and motion.moves(inst):
+                warnings.append("light '%s' moves over the shutter: lights are not motion "
+                                "blurred; it shines from where it is at the shutter's centre"
+                                % obj.name)
             ext, khr = convert_light(obj.data, obj, matrix(inst.matrix_world), warnings,
                                      images)
             node = {"name": obj.name, "matrix": gltf_matrix(matrix(inst.matrix_world)),
@@ -367,15 +382,24 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
 
     res.instanced_nodes = collapse(doc, root_nodes, buf, mesh_nodes, used_ext)
 
-    if getattr(scene.render, "use_motion_blur", False):
-        warnings.append("motion blur is not rendered; objects render at the frame's instant")
+    if motion is not None:
+        warnings.extend(motion.warnings)
+    elif getattr(scene.render, "use_motion_blur", False):
+        # Only a render samples the shutter (it needs the engine to change frames).
+        warnings.append("motion blur is not rendered in this export (only renders sample the "
+                        "shutter); objects are exported at the frame's instant")
     cam = camera if camera is not None else scene.camera
     if cam is not None and cam.type == "CAMERA":
         aspect = pixel_aspect(scene.render)
         doc["cameras"].append(dict(camera_fields(cam.data, width, height, aspect),
                                    name=cam.data.name))
-        add_node({"name": cam.name, "camera": 0, "matrix": gltf_matrix(camera_matrix(cam)),
-                  "extensions": {"TESELA_camera": camera_extension(cam, warnings, aspect)}})
+        cam_node = {"name": cam.name, "camera": 0, "matrix": gltf_matrix(camera_matrix(cam)),
+                    "extensions": {"TESELA_camera": camera_extension(cam, warnings, aspect)}}
+        keys = motion.camera_extension() if motion is not None else None
+        if keys is not None:
+            cam_node["extensions"]["TESELA_motion"] = keys
+            used_ext.add("TESELA_motion")
+        add_node(cam_node)
         used_ext.add("TESELA_camera")
         res.has_camera = True
 

@@ -50,9 +50,11 @@ def decompose(m):
 
 def _collapsible(node):
     """Whether a node's object data is shared by every placement of its mesh (all but the
-    random number and location, which the instancing node carries per instance)."""
+    random number and location, which the instancing node carries per instance); a moving
+    placement keeps its own node, with its keys."""
     obj = node.get("extras", {}).get("tesela_object", {})
-    return ("TESELA_light_linking" not in node.get("extensions", {})
+    extensions = node.get("extensions", {})
+    return ("TESELA_light_linking" not in extensions and "TESELA_motion" not in extensions
             and "particle" not in obj and "instancer" not in obj.get("attributes", {}))
 
 
