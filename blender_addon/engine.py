@@ -12,6 +12,7 @@ import numpy as np
 
 from . import compat, export, passes, preferences, protocol, render_jobs, report, viewport
 from .process import StderrTail, _describe_exit, make_tmpdir, stop_process, sweep_stale_tmpdirs
+from .settings import SceneSettings
 
 POLL_SECONDS = 0.03        # how often render() looks at the queue and test_break()
 PUSH_SECONDS = 0.25        # how often the render result is refreshed
@@ -242,7 +243,7 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
     def update_render_passes(self, scene=None, renderlayer=None):
         """Declares the passes Blender's compositor and render result will have."""
         self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
-        for _, bname, ids, kind in passes.enabled(renderlayer, scene.tesela):
+        for _, bname, ids, kind in passes.enabled(renderlayer, SceneSettings(scene)):
             self.register_pass(scene, renderlayer, compat.pass_name(bname), len(ids), ids, kind)
 
     # -- render -----------------------------------------------------------------
@@ -250,7 +251,9 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
     def render(self, depsgraph):
         scene = depsgraph.scene
         r = scene.render
-        settings = PreviewSettings(scene.tesela) if self.is_preview else scene.tesela
+        settings = SceneSettings(scene)
+        if self.is_preview:
+            settings = PreviewSettings(settings)
         width, height = export.render_size(r)
         region = export.border_region(r, width, height)
         _, _, rw, rh = region if region is not None else (0, 0, width, height)

@@ -7,6 +7,7 @@ from bpy.props import BoolProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper
 
 from . import export, preferences, report
+from .settings import FOLLOWS_CYCLES, SceneSettings, source
 
 ENGINE = "TESELA"
 
@@ -47,55 +48,67 @@ class TESELA_PT_render(bpy.types.Panel):
         layout = self.layout
         layout.use_property_split = True
         layout.use_property_decorate = False
-        s = context.scene.tesela
+        scene = context.scene
+        s = SceneSettings(scene)
+
+        def prop(col, name, **kw):
+            # A setting not set for Tesela shows (and edits) the Cycles setting it follows.
+            owner, attr = source(scene.tesela, getattr(scene, "cycles", None), name)
+            if attr == "max_bounces":
+                kw.setdefault("text", "Max Bounces")
+            col.prop(owner, attr, **kw)
+
         # Laid out as Cycles' render properties, with Cycles' property names.
         col = layout.column(heading="Sampling")
         row = col.row(heading="Noise Threshold", align=True)
-        row.prop(s, "use_adaptive_sampling", text="")
+        prop(row, "use_adaptive_sampling", text="")
         sub = row.row()
         sub.active = s.use_adaptive_sampling
-        sub.prop(s, "adaptive_threshold", text="")
-        col.prop(s, "samples", text="Max Samples" if s.use_adaptive_sampling else "Samples")
+        prop(sub, "adaptive_threshold", text="")
+        prop(col, "samples", text="Max Samples" if s.use_adaptive_sampling else "Samples")
         sub = col.column()
         sub.active = s.use_adaptive_sampling
-        sub.prop(s, "adaptive_min_samples")
-        col.prop(s, "time_limit")
+        prop(sub, "adaptive_min_samples")
+        prop(col, "time_limit")
         col = layout.column(heading="Viewport")
-        col.prop(s, "preview_samples", text="Samples")
-        col.prop(s, "preview_start_resolution")
-        col.prop(context.scene.render, "preview_pixel_size", text="Pixel Size")
-        col.prop(s, "use_preview_denoising")
+        prop(col, "preview_samples", text="Samples")
+        prop(col, "preview_start_resolution")
+        col.prop(scene.render, "preview_pixel_size", text="Pixel Size")
+        prop(col, "use_preview_denoising")
         row = col.row(align=True)
-        row.prop(s, "seed")
-        row.prop(s, "use_animated_seed", text="", icon="TIME")
+        prop(row, "seed")
+        prop(row, "use_animated_seed", text="", icon="TIME")
         col = layout.column(heading="Denoise")
-        col.prop(s, "use_denoising")
+        prop(col, "use_denoising")
         sub = col.column()
         sub.active = s.use_denoising
-        sub.prop(s, "denoising_prefilter")
-        layout.prop(s, "denoising_store_passes")
+        prop(sub, "denoising_prefilter")
+        prop(layout, "denoising_store_passes")
         col = layout.column(heading="Light Paths")
-        col.prop(s, "max_depth")
-        for prop in ("diffuse_bounces", "glossy_bounces", "transmission_bounces",
+        prop(col, "max_depth")
+        for name in ("diffuse_bounces", "glossy_bounces", "transmission_bounces",
                      "volume_bounces", "transparent_max_bounces"):
-            col.prop(s, prop)
+            prop(col, name)
         col = layout.column(heading="Clamping")
-        col.prop(s, "sample_clamp_direct")
-        col.prop(s, "sample_clamp_indirect")
+        prop(col, "sample_clamp_direct")
+        prop(col, "sample_clamp_indirect")
         col = layout.column()
-        col.prop(s, "blur_glossy")
+        prop(col, "blur_glossy")
         col = layout.column(heading="Caustics")
-        col.prop(s, "caustics_reflective", text="Reflective")
-        col.prop(s, "caustics_refractive", text="Refractive")
+        prop(col, "caustics_reflective", text="Reflective")
+        prop(col, "caustics_refractive", text="Refractive")
         col = layout.column(heading="Film")
-        col.prop(context.scene.render, "film_transparent", text="Transparent")
-        col.prop(s, "pixel_filter_type")
-        col.prop(s, "filter_width")
+        col.prop(scene.render, "film_transparent", text="Transparent")
+        prop(col, "pixel_filter_type")
+        prop(col, "filter_width")
         col = layout.column(heading="Performance")
-        col.prop(s, "threads")
-        col.prop(s, "tile_size")
+        prop(col, "threads")
+        prop(col, "tile_size")
         col = layout.column(heading="Debug")
-        col.prop(s, "integrator")
+        prop(col, "integrator")
+        if any(s.follows_cycles(n) for n in FOLLOWS_CYCLES + ("max_depth",)):
+            layout.label(text="Settings not changed for Tesela are the scene's Cycles settings",
+                         icon="INFO")
         path, tried = preferences.find_renderer(context)
         if path is None:
             box = layout.box()

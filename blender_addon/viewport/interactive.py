@@ -15,6 +15,7 @@ import bpy
 
 from .. import export, preferences
 from ..process import make_tmpdir, sweep_stale_tmpdirs
+from ..settings import SceneSettings
 from . import updates
 from .display import Display, draw_messages
 from .session_client import SessionClient
@@ -34,7 +35,7 @@ def render_seed(settings, frame):
 def session_settings(scene, pixel_size):
     """The `settings` command's fields: the viewport's sampling (preview_*) and the scene's
     light paths and film, as F12 passes them to `tesela render`."""
-    s = scene.tesela
+    s = SceneSettings(scene)
     return {"samples": int(s.preview_samples),
             "start_resolution": int(s.preview_start_resolution),
             "pixel_size": int(pixel_size),

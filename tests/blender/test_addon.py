@@ -1094,3 +1094,83 @@ def test_light_passes_are_registered_with_blenders_names_and_channels():
     if bpy.app.version >= (4, 2, 0):
         assert compat.pass_name("GlossInd") == "Glossy Indirect"
         assert compat.pass_name("Noisy Image") == "Noisy Image"
+
+
+def test_settings_follow_the_scenes_cycles_settings_until_set(addon):
+    """An artist's scene carries its Light Paths, Sampling and Film choices in scene.cycles:
+    a Tesela render takes them (Max Bounces as path vertices) until scene.tesela sets its
+    own, and the Tesela panel shows (and edits) the Cycles setting it follows."""
+    from blender_addon.settings import FOLLOWS_CYCLES, SceneSettings
+    scene = bpy.context.scene
+    t, c = scene.tesela, scene.cycles
+    changed = {"samples": 77, "max_bounces": 5, "sample_clamp_indirect": 3.0,
+               "filter_width": 2.0, "caustics_refractive": False, "pixel_filter_type": "GAUSSIAN"}
+    saved_cycles = {k: getattr(c, k) for k in changed}
+    names = FOLLOWS_CYCLES + ("max_depth",)
+    saved_tesela = {k: getattr(t, k) for k in names if t.is_property_set(k)}
+    try:
+        for k in names:
+            t.property_unset(k)
+        for k, v in changed.items():
+            setattr(c, k, v)
+        s = SceneSettings(scene)
+        args = tesela_engine.renderer_args("tesela", "s.gltf", s, 8, 8, None)
+        joined = " ".join(args)
+        for want in ("--spp 77", "--max-depth 7", "--clamp-indirect 3.0", "--filter gaussian",
+                     "--filter-width 2.0", "--no-caustics-refractive"):
+            assert want in joined, (want, joined)
+        assert s.follows_cycles("samples") and not s.follows_cycles("integrator")
+        # Set for Tesela: its own value, whatever Cycles says.
+        t.samples, t.max_depth, t.caustics_refractive = 5, 3, True
+        joined = " ".join(tesela_engine.renderer_args("tesela", "s.gltf", s, 8, 8, None))
+        assert "--spp 5" in joined and "--max-depth 3" in joined
+        assert "--no-caustics-refractive" not in joined and "--filter-width 2.0" in joined
+        assert not s.follows_cycles("samples")
+    finally:
+        for k, v in saved_cycles.items():
+            setattr(c, k, v)
+        for k in names:
+            t.property_unset(k)
+        for k, v in saved_tesela.items():
+            setattr(t, k, v)
+
+
+class _Layout:
+    """Records what a panel draws (bpy layouts cannot be made without a window)."""
+
+    def __init__(self, drawn):
+        self.drawn = drawn
+        self.use_property_split = self.use_property_decorate = self.active = None
+
+    def column(self, **kw):
+        return self
+
+    row = box = column
+
+    def prop(self, owner, name, **kw):
+        self.drawn.append((owner, name, kw.get("text")))
+
+    def label(self, **kw):
+        self.drawn.append((None, "label", kw.get("text")))
+
+
+def test_render_panel_shows_the_cycles_setting_a_tesela_setting_follows(addon):
+    from types import SimpleNamespace
+
+    from blender_addon import ui
+    scene = bpy.context.scene
+    t = scene.tesela
+    was_set = t.is_property_set("samples"), t.samples
+    t.property_unset("samples")
+    t.glossy_bounces = t.glossy_bounces
+    try:
+        drawn = []
+        panel = SimpleNamespace(layout=_Layout(drawn))
+        ui.TESELA_PT_render.draw(panel, SimpleNamespace(scene=scene, engine="TESELA"))
+        owners = {name: owner for owner, name, _ in drawn}
+        assert owners["samples"] == scene.cycles
+        assert owners["glossy_bounces"] == t and owners["integrator"] == t
+        assert any(n == "label" and "Cycles" in (text or "") for _, n, text in drawn)
+    finally:
+        if was_set[0]:
+            t.samples = was_set[1]
