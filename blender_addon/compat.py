@@ -345,6 +345,21 @@ def corner_uvs(mesh, n_loops):
     return corner_uv(layers[0], n_loops) if layers else None
 
 
+def adaptive_subdivision(obj, scene):
+    """Whether Cycles would dice `obj` by adaptive subdivision: its last modifier a Subdivision
+    Surface with Adaptive Subdivision on (a modifier setting since 5.0; before, the object's
+    Cycles setting, used only with the Experimental feature set)."""
+    mods = [m for m in getattr(obj, "modifiers", ()) if m.show_render]
+    last = mods[-1] if mods else None
+    if last is None or last.type != "SUBSURF":
+        return False
+    if hasattr(last, "use_adaptive_subdivision"):
+        return bool(last.use_adaptive_subdivision)
+    cycles = getattr(scene, "cycles", None)
+    return (getattr(cycles, "feature_set", "") == "EXPERIMENTAL"
+            and bool(getattr(getattr(obj, "cycles", None), "use_adaptive_subdivision", False)))
+
+
 def light_is_portal(light):
     """Whether an area light is a Cycles portal (light.cycles.is_portal, 2.8-5.x)."""
     return bool(getattr(getattr(light, "cycles", None), "is_portal", False))

@@ -113,6 +113,9 @@ def renderer_args(binary, gltf, settings, width, height, region, pass_names=(), 
     return args
 
 
+# Export warnings shown in Blender's reports, the rest in the console.
+MAX_SHOWN_WARNINGS = 8
+
 OLD_RENDERER = ("the renderer %s is older than this add-on: it does not speak pipe protocol "
                 "version %d (install the renderer that came with the add-on)")
 
@@ -316,6 +319,15 @@ class TeselaRenderEngine(bpy.types.RenderEngine):
             print("Tesela: " + w)
         if len(res.warnings) > 20:
             print("Tesela: ... and %d more warnings" % (len(res.warnings) - 20))
+        # What is left out or approximated besides materials (objects, lights, camera, world,
+        # motion blur) is shown in Blender too; materials are summed up below.
+        per_material = {t for texts in res.material_warnings.values() for t in texts}
+        others = [w for w in res.warnings if w not in per_material]
+        for w in others[:MAX_SHOWN_WARNINGS]:
+            self.report({"WARNING"}, "Tesela: " + w)
+        if len(others) > MAX_SHOWN_WARNINGS:
+            self.report({"WARNING"}, "Tesela: ... and %d more (see the console)"
+                        % (len(others) - MAX_SHOWN_WARNINGS))
         if res.material_warnings:
             self.report({"WARNING"}, "Tesela: %d material(s) could not be translated fully (see "
                         "Material Properties > Tesela)" % len(res.material_warnings))

@@ -14,7 +14,8 @@ import threading
 # `material 'NAME': node 'NODE' (TYPE) message` (the material name ends at the first
 # "': node '", the node name at the first "' (TYPE)" after it).
 _RENDERER_LINE = re.compile(
-    r"material '(?P<material>.*?)': node '(?P<node>.*?)' \((?P<type>[A-Za-z0-9_]+)\)(?P<rest>.*)$")
+    r"material '(?P<material>.*?)': (?:shader )?node '(?P<node>.*?)' \((?P<type>[A-Za-z0-9_]+)\)"
+    r"(?P<rest>.*)$")
 
 _lock = threading.Lock()
 _published = {}  # scene name -> FallbackReport

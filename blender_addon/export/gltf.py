@@ -265,6 +265,7 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
         return mesh_cache[key]
 
     skipped_types = set()
+    adaptive_reported = set()
     hair_reported = set()
     linking = LightLinking(depsgraph.objects)
     count = 0
@@ -309,6 +310,11 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
             # particles render (as Cycles reads the instance's show_self).
             continue
         if otype in MESHLIKE:
+            if obj.name not in adaptive_reported and compat.adaptive_subdivision(obj, scene):
+                adaptive_reported.add(obj.name)
+                warnings.append("object '%s': adaptive subdivision is not rendered; the mesh "
+                                "renders as Blender evaluates it, without Cycles' dicing"
+                                % obj.name)
             cached = object_mesh(obj)
             if cached is None:
                 continue

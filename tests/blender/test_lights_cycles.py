@@ -445,3 +445,42 @@ def test_a_lights_own_max_bounces_is_reported(addon, tmp_path):  # noqa: F811
     res = export.write_gltf(depsgraph, str(tmp_path / "b.gltf"), width=8, height=8)
     about = [w for w in res.warnings if "Max Bounces" in w]
     assert len(about) == 1 and "'Limited'" in about[0] and "(3)" in about[0], res.warnings
+
+
+def test_export_warnings_reach_blenders_reports(addon, tesela_bin, tmp_path, monkeypatch,  # noqa: F811
+                                                capfd):
+    """What the export leaves out besides materials (here a portal light) is shown in
+    Blender's reports of the render (which Blender prints as "Warning: ..." without a window),
+    not only printed to the console."""
+    monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
+    info = scenes.light_over_plane("point")
+    portal = scenes.add_area_light("Window", (0, -2, 1.5), (0, 0, 1.5), 10.0, 1.0)
+    portal.data.cycles.is_portal = True
+    scene = info.scene
+    scenes.configure_cycles(scene, 16, 16, 4, 0, seed=1)
+    scene.render.engine = "TESELA"
+    scene.tesela.samples = 4
+    capfd.readouterr()
+    assert bpy.ops.render.render() == {"FINISHED"}
+    out = capfd.readouterr().out
+    assert "Warning: Tesela: light 'Window' is a portal" in out, out
+
+
+@pytest.mark.skipif("use_adaptive_subdivision" not in bpy.types.SubsurfModifier.bl_rna.properties,
+                    reason="Adaptive Subdivision is a modifier setting from Blender 5.0")
+def test_adaptive_subdivision_is_reported(addon, tmp_path):  # noqa: F811
+    """Cycles dices a mesh whose last modifier is an adaptive Subdivision Surface; Tesela
+    renders the evaluated mesh and says so, naming the object (once)."""
+    from blender_addon import export
+
+    scenes.clear_scene()
+    rock = scenes.add_box("Rock", (-0.5, -0.5, 0.0), (0.5, 0.5, 1.0),
+                          scenes.lambert("R", (0.8,) * 3))
+    plain = scenes.add_box("Plain", (1.0, -0.5, 0.0), (2.0, 0.5, 1.0),
+                           scenes.lambert("P", (0.8,) * 3))
+    rock.modifiers.new("Subdivision", "SUBSURF").use_adaptive_subdivision = True
+    plain.modifiers.new("Subdivision", "SUBSURF")
+    res = export.write_gltf(bpy.context.evaluated_depsgraph_get(), str(tmp_path / "a.gltf"),
+                            width=8, height=8)
+    said = [w for w in res.warnings if "adaptive subdivision" in w]
+    assert len(said) == 1 and "'Rock'" in said[0], res.warnings

@@ -753,6 +753,10 @@ def test_fallback_report_parses_renderer_lines():
     assert not r.add_renderer_line("rendering 64 samples")
     assert r.add_renderer_line("warning: material 'B': node 'X' (ShaderNodeScript) unsupported (OSL)")
     r.add_renderer_line("material 'B': node 'X' (ShaderNodeScript) unsupported (OSL)")  # duplicate
+    # A shader node the renderer mutes says so in its own words.
+    assert r.add_renderer_line("material 'Portal': shader node 'Ray Portal BSDF' "
+                               "(ShaderNodeBsdfRayPortal) is not supported; it renders as muted")
+    assert len(r.for_material("Portal")[1]) == 1
     addon_lines, lines = r.for_material("Wood's \"best\"")
     assert addon_lines == [] and len(lines) == 1 and "node 'Noise (fine)'" in lines[0]
     assert r.for_material("B")[1] == ["material 'B': node 'X' (ShaderNodeScript) unsupported (OSL)"]
