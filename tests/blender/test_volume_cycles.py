@@ -105,6 +105,24 @@ def principled_volume_ball():
     return scenes.SceneInfo(bpy.context.scene, "principled_volume_ball")
 
 
+def coefficients_ball():
+    """A ball of Volume Coefficients (Blender 5.0: absorption, scattering and emission given
+    per channel in 1/m): reddish scattering, blue-absorbing, a faint green glow, lit by a point
+    light."""
+    _stage()
+    bpy.data.objects.remove(bpy.data.objects["Sun"], do_unlink=True)
+    scenes.add_point_light("Lamp", (0.9, -0.6, 1.6), 60.0, radius=0.1)
+    mat, nt, out = _volume_only("Coefficients")
+    vol = nt.nodes.new("ShaderNodeVolumeCoefficients")
+    vol.inputs["Absorption Coefficients"].default_value = (0.2, 0.6, 1.8)
+    vol.inputs["Scatter Coefficients"].default_value = (2.0, 1.2, 0.6)
+    vol.inputs["Anisotropy"].default_value = 0.3
+    vol.inputs["Emission Coefficients"].default_value = (0.0, 0.15, 0.05)
+    nt.links.new(vol.outputs[0], out.inputs["Volume"])
+    scenes.add_sphere("Ball", (0.0, 0.0, 0.75), 0.7, mat)
+    return scenes.SceneInfo(bpy.context.scene, "coefficients_ball")
+
+
 def camera_in_fog():
     """Thin fog filling a large box around the whole stage, camera included: the floor and
     wall fade with distance and the sun's light scatters towards the camera."""
@@ -208,6 +226,10 @@ CASES = [
     ("fog_box", fog_box, 4, "path_mis", 512),
     ("principled_volume_ball", principled_volume_ball, 4, "path_mis", 512),
     ("camera_in_fog", camera_in_fog, 4, "path_mis", 512),
+    pytest.param(("coefficients_ball", coefficients_ball, 4, "path_mis", 512),
+                 id="coefficients_ball",
+                 marks=pytest.mark.skipif(not hasattr(bpy.types, "ShaderNodeVolumeCoefficients"),
+                                          reason="Volume Coefficients is a Blender 5.0 node")),
     ("glowing_volume", glowing_volume, 4, "path_mis", 1024),
     ("white_cloud", white_cloud, 12, "path_mis", 512),
     ("world_fog", world_fog, 4, "path_mis", 512),
@@ -216,6 +238,6 @@ CASES = [
 ]
 
 
-@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
+@pytest.mark.parametrize("case", CASES, ids=[None if hasattr(c, "marks") else c[0] for c in CASES])
 def test_volume_agrees_with_cycles(addon, tesela_bin, tmp_path, monkeypatch, case):  # noqa: F811
     agrees_with_cycles(tesela_bin, tmp_path, monkeypatch, case)

@@ -22,6 +22,7 @@ pub fn is_shader_node(kind: &str) -> bool {
                 | "ShaderNodeVolumeAbsorption"
                 | "ShaderNodeVolumeScatter"
                 | "ShaderNodeVolumePrincipled"
+                | "ShaderNodeVolumeCoefficients"
                 | "ShaderNodeGroup"
         )
 }
@@ -186,6 +187,14 @@ pub enum ClosureParams {
         color: Slot,
         density: Slot,
         anisotropy: Slot,
+    },
+    /// The Volume Coefficients node: `σ_a`, `σ_s` (1/m, per channel) and emission
+    /// (radiance per metre) given directly, Henyey–Greenstein `anisotropy`.
+    Coefficients {
+        absorption: Slot,
+        scatter: Slot,
+        anisotropy: Slot,
+        emission: Slot,
     },
     /// The Principled Volume node as Cycles' `svm_node_principled_volume`: `σ_s = ρ c`,
     /// `σ_a = ρ max(1 - c, 0) max(1 - √a, 0)` (`ρ` density, `c` colour, `a` absorption
@@ -590,6 +599,19 @@ impl ClosureOp {
                 let sigma = col(*color).max(Vec3::ZERO) * s.f(*density).max(0.0);
                 out.add_scatter(sigma * w, s.f(*anisotropy));
             }
+            ClosureParams::Coefficients {
+                absorption,
+                scatter,
+                anisotropy,
+                emission,
+            } => {
+                out.add_absorption(col(*absorption).max(Vec3::ZERO) * w);
+                out.add_scatter(col(*scatter).max(Vec3::ZERO) * w, s.f(*anisotropy));
+                let e = col(*emission);
+                if e.max_element() > 0.0 {
+                    out.add_emission(e * w);
+                }
+            }
             ClosureParams::PrincipledVolume {
                 color,
                 density,
@@ -654,6 +676,20 @@ fn compile_volume_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, 
                 color: cx.color("Color", Vec3::splat(0.8))?,
                 density: cx.float("Density", 1.0)?,
                 anisotropy: cx.float("Anisotropy", 0.0)?,
+            }
+        }
+        "ShaderNodeVolumeCoefficients" => {
+            match cx.prop_str("phase").unwrap_or("HENYEY_GREENSTEIN") {
+                "HENYEY_GREENSTEIN" => {}
+                p => cx.warn(&format!(
+                    "the {p} phase function renders as Henyey-Greenstein of the node's anisotropy"
+                )),
+            }
+            ClosureParams::Coefficients {
+                absorption: cx.vector("Absorption Coefficients", Vec3::ONE)?,
+                scatter: cx.vector("Scatter Coefficients", Vec3::ONE)?,
+                anisotropy: cx.float("Anisotropy", 0.0)?,
+                emission: cx.vector("Emission Coefficients", Vec3::ZERO)?,
             }
         }
         "ShaderNodeVolumePrincipled" => {
