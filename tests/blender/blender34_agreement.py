@@ -4,7 +4,7 @@ tests/blender/scenes.py with Cycles and with Tesela (through the add-on), both t
     blender -b --factory-startup --addons tesela --python blender34_agreement.py -- \
         SCENE OUT_DIR SIZE SPP MAX_BOUNCES INTEGRATOR
 
-SCENE: cornell | cornell_spheres | point | spot | sun | area | emissive_sphere
+SCENE: cornell | cornell_spheres | point | spot | sun | area | emissive_sphere | motion_blur
 """
 
 import math
@@ -31,6 +31,21 @@ elif kind == "area":
     scenes.add_area_light("Area", (0.3, -0.2, 1.8), (0.2, 0.1, 0.0), 150.0, 0.8)
 elif kind == "emissive_sphere":
     info = scenes.emissive_sphere()
+elif kind == "motion_blur":
+    # The box slides along x from frame 1 to 3 and the camera pans; frame 2 is rendered with
+    # a full-frame shutter centred on it.
+    info = scenes.light_over_plane("sun")
+    box = next(o for o in info.scene.objects if o.type == "MESH" and o.name != "Plane")
+    for frame, x in ((1, -0.8), (3, 0.8)):
+        box.location.x = x
+        box.keyframe_insert("location", frame=frame)
+    cam = info.scene.camera
+    for frame, dx in ((1, -0.1), (3, 0.1)):
+        cam.location.x = dx
+        cam.keyframe_insert("location", frame=frame)
+    info.scene.frame_set(2)
+    info.scene.render.use_motion_blur = True
+    info.scene.render.motion_blur_shutter = 1.0
 else:
     raise SystemExit("unknown scene " + kind)
 

@@ -334,6 +334,7 @@ AGREEMENT_34 = [
     pytest.param(("sun", 0, "direct_mis", 64), id="sun-direct_mis"),
     _xfail34(("area", 0, "direct_mis", 256), "Cycles 3.4 area lights: 0.80x Cycles 5.0's"),
     pytest.param(("emissive_sphere", 0, "direct_mis", 256), id="emissive_sphere-direct_mis"),
+    pytest.param(("motion_blur", 0, "direct_mis", 256), id="motion_blur-direct_mis"),
 ]
 
 
