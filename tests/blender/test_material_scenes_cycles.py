@@ -1103,6 +1103,20 @@ def transparent_depth_stack():
     world(0.5)
 
 
+def ray_portal_window():
+    """A tinted Ray Portal BSDF (Blender 4.2+) pane with its Position and Direction unlinked:
+    rays go on through it from where they hit, so the box behind it, the floor and the sun's
+    shadow of the box are seen through the tint, and the pane's own shadow is tinted."""
+    lit_floor((-0.3, 0.4, -1.0), (0.0, 0.0, 0.5))
+    mat, nt, out = node_material("Portal")
+    rp = node(nt, "ShaderNodeBsdfRayPortal")
+    rp.inputs["Color"].default_value = (0.9, 0.6, 0.3, 1.0)
+    surface(nt, out, rp.outputs[0])
+    scenes.add_quad("Pane", [(-1.0, -0.5, 0.1), (1.0, -0.5, 0.1), (1.0, -0.5, 1.3),
+                             (-1.0, -0.5, 1.3)], mat)
+    scenes.add_box("Box", (-0.3, 0.2, 0.0), (0.3, 0.8, 0.6), scenes.lambert("B", (0.3, 0.6, 0.8)))
+
+
 def lit_floor(sun_direction, camera_target):
     """A cleared scene with a 6 m grey floor under a sun of strength 3 along `sun_direction`,
     a dim world (0.3) and a camera at (0, -4, 3) looking at `camera_target` (40 degrees)."""
@@ -1229,6 +1243,9 @@ CASES = [
     ("light_path_depths_in_mirror", light_path_depths_in_mirror, 2, 16, 64),
     ("light_path_depth_lighting", light_path_depth_lighting, 2, 256, 1024),
     ("transparent_depth_stack", transparent_depth_stack, 2, 64, 256),
+    pytest.param(("ray_portal_window", ray_portal_window, 2, 64, 256), id="ray_portal_window",
+                 marks=pytest.mark.skipif(not hasattr(bpy.types, "ShaderNodeBsdfRayPortal"),
+                                          reason="the Ray Portal BSDF is a Blender 4.2 node")),
     ("packed_roughness_metallic", packed_rough_metal, 0, 256, 1024),
     ("normal_map_gentle_lambert", lambda: normal_map(0.02, (-0.3, 0.2, -1.0), 0.0), 0, 128, 512),
     ("normal_map_gentle_principled", lambda: normal_map(0.02, (-0.3, 0.2, -1.0)), 0, 128, 512),

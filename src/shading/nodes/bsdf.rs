@@ -162,6 +162,12 @@ pub enum ClosureParams {
     Transparent {
         color: Slot,
     },
+    /// The Ray Portal BSDF with its Position and Direction unlinked: camera and indirect rays
+    /// go on through it, tinted, as through a Transparent BSDF; shadow rays stop there (Cycles'
+    /// portals are opaque to shadow rays).
+    Portal {
+        color: Slot,
+    },
     /// The Subsurface Scattering node.
     Subsurface {
         color: Slot,
@@ -560,6 +566,17 @@ impl ClosureOp {
                 Vec3::ZERO,
                 ClosureKind::Transparent { color: Vec3::ONE },
             ),
+            ClosureParams::Portal { color } => {
+                if g.ray_flags & crate::shading::globals::ray::SHADOW == 0 {
+                    push(
+                        out,
+                        col(*color) * w,
+                        Vec3::ZERO,
+                        Vec3::ZERO,
+                        ClosureKind::Transparent { color: Vec3::ONE },
+                    );
+                }
+            }
             ClosureParams::Subsurface {
                 color,
                 scale,
@@ -1148,6 +1165,20 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                 color: cx.color("Color", Vec3::ONE)?,
             }
         }
+        "ShaderNodeBsdfRayPortal" => {
+            // Unlinked, Position and Direction are the hit point and the ray's own direction:
+            // the ray goes on through the surface, tinted, as through a Transparent BSDF.
+            if cx.is_linked("Position") || cx.is_linked("Direction") {
+                cx.warn(
+                    "a Ray Portal BSDF with a linked Position or Direction renders as if \
+                     unlinked (rays go on through the surface, not from the given position)",
+                );
+            }
+            cx.passes();
+            ClosureParams::Portal {
+                color: cx.color("Color", Vec3::ONE)?,
+            }
+        }
         "ShaderNodeEmission" => {
             cx.emits();
             ClosureParams::Emission {
@@ -1166,7 +1197,8 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
     // A Principled BSDF's emission under a coat or sheen, and a sheen over a coat, depend on
     // the view direction.
     let varying = matches!(&params,
-        ClosureParams::Principled(p) if p.layered_emission || p.sheen_over_coat);
+        ClosureParams::Principled(p) if p.layered_emission || p.sheen_over_coat)
+        || matches!(params, ClosureParams::Portal { .. });
     cx.emit(Op::Closure(ClosureOp { weight: w, params }), varying);
     let _ = SocketType::Shader;
     Ok(true)
