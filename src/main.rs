@@ -1145,7 +1145,12 @@ fn run_info(path: &Path) -> ExitCode {
                 );
             }
             if s.settings.film_transparent {
-                println!("  film: transparent");
+                match s.settings.film_transparent_glass {
+                    Some(t) => {
+                        println!("  film: transparent, transparent glass (roughness <= {t})")
+                    }
+                    None => println!("  film: transparent"),
+                }
             }
             for w in &s.warnings {
                 println!("  warning: {w}");

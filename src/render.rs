@@ -378,8 +378,10 @@ fn render_samples(
         if l.is_finite() {
             acc.sum += l;
             acc.accepted += 1;
+            // Film > Transparent Glass: less the share the path found the world with through
+            // transmission (not clamped: the mean over samples is).
             let coverage = if transparent {
-                scene.camera_coverage(ctx, ray.o, ray.d)
+                scene.camera_coverage(ctx, ray.o, ray.d) - ctx.see_through
             } else {
                 1.0
             };

@@ -241,6 +241,16 @@ pub struct Ctx {
     /// The path's shutter time in `[0, 1)` (motion blur): every ray of the path sees the
     /// scene as it is then. 0.5 in scenes without motion, where nothing reads it.
     pub time: f32,
+    /// The path still has Cycles' transparent-background state (Film > Transparent Glass,
+    /// [`RenderScene::transparent_glass`]): it has gone from the camera through transparent
+    /// surfaces and transmissions no rougher than the threshold only. Where such a path
+    /// escapes past its first vertex the world adds no colour, and the path integrators add
+    /// its throughput's mean to [`Ctx::see_through`]. Always false without the setting.
+    pub clear_path: bool,
+    /// The share of the current camera sample that reached the world through transmission
+    /// with [`Ctx::clear_path`] kept (what the film's coverage loses beyond
+    /// [`RenderScene::camera_coverage`]).
+    pub see_through: f32,
 }
 
 /// A path vertex's index and the path's bounces of each kind before it: what an emitter's
@@ -285,6 +295,8 @@ impl Ctx {
             camera_hit: None,
             catchers_only: false,
             time: 0.5,
+            clear_path: false,
+            see_through: 0.0,
         }
     }
 
@@ -1886,6 +1898,19 @@ impl RenderScene {
             EmitterInstance::Environment(env) => env.radiance(&self.scene, d, 1, flags),
             e => e.eval(&self.scene, &EmitterQueryRecord::towards(from, d)),
         }
+    }
+
+    /// Cycles' Film > Transparent Glass, on with a transparent film: the most
+    /// `alpha_x · alpha_y` (GGX alphas, each the roughness squared) of a transmission that keeps
+    /// a camera path's transparent background, i.e. the roughness threshold to the fourth
+    /// power (Cycles' `transparent_roughness_squared_threshold`); `None` when off.
+    #[inline]
+    pub fn transparent_glass(&self) -> Option<f32> {
+        let s = &self.scene.settings;
+        if !s.film_transparent {
+            return None;
+        }
+        s.film_transparent_glass.map(|t| (t * t) * (t * t))
     }
 
     /// The film's coverage along a camera ray (its alpha): 1 without `film_transparent`;

@@ -526,7 +526,8 @@ fn tesela_world_graph_images_sky_and_settings_load() {
             "TESELA_images": {"images": [{"name": "sky", "width": 2, "height": 1, "channels": 3,
                                           "component": "f32", "bufferView": 0,
                                           "colorspace": "Non-Color"}]},
-            "TESELA_render": {"film_transparent": true},
+            "TESELA_render": {"film_transparent": true, "film_transparent_glass": true,
+                              "film_transparent_roughness": 0.25},
             "TESELA_world": {
                 "name": "Sunset", "color": [0.1, 0.2, 0.3], "strength": 1.0,
                 "visible_camera": false, "sampling": "MANUAL", "map_resolution": 256,
@@ -549,6 +550,7 @@ fn tesela_world_graph_images_sky_and_settings_load() {
     let s =
         tesela::scene::gltf::load_from_slice(&inputs::json_bytes(&doc), None, "w.gltf").unwrap();
     assert!(s.settings.film_transparent);
+    assert_eq!(s.settings.film_transparent_glass, Some(0.25));
     assert!(!s.world.visible_camera);
     assert_eq!(s.world.sampling, WorldSampling::Manual(256));
     assert_eq!(s.world.name, "Sunset");
@@ -800,4 +802,35 @@ fn black_cells_are_never_sampled() {
         assert!(w.is_finite());
     }
     let _ = Vec2::ZERO;
+}
+
+/// Film > Transparent Glass: a glass ball in front of the sky on a transparent film. With it,
+/// the sky seen through the ball is transparent (less alpha, less colour there); without it
+/// the ball is opaque; the render is the same for any thread count.
+#[test]
+fn transparent_glass_clears_the_world_seen_through_glass() {
+    let mut s = env_scene(sun_sky(), 1.0, 0.0);
+    s.materials.push(Material::glass("ball", 1.45));
+    s.meshes.push(sphere("ball", 0, Vec3::ZERO, 1.0, 24, 48));
+    s.camera = camera(Mat4::from_translation(Vec3::new(0.0, 0.0, 4.0)), 40.0);
+    s.settings.film_transparent = true;
+    let mut g = s.clone();
+    g.settings.film_transparent_glass = Some(0.1);
+    let mut o = opts("path_mis", 16, 16, 8, 3);
+    let off = render_with(s, &o);
+    let on = render_with(g.clone(), &o);
+    let centre = 8 * 16 + 8;
+    assert_eq!(
+        off[centre][3], 1.0,
+        "without the setting the glass is opaque"
+    );
+    assert!(
+        on[centre][3] < 0.5,
+        "the sky through the glass: alpha {}",
+        on[centre][3]
+    );
+    assert!(on[centre][0] < off[centre][0], "and no sky colour");
+    assert_eq!(on[0], off[0], "the sky beside the ball is the same");
+    o.threads = 1;
+    assert_eq!(render_with(g, &o), on, "the same for any thread count");
 }

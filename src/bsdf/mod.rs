@@ -195,6 +195,23 @@ impl BsdfInstance {
         }
     }
 
+    /// `alpha_x · alpha_y` of the lobe a transmitted ray leaves through (Cycles'
+    /// `bsdf_get_specular_roughness_squared`): 0 for a smooth dielectric, the GGX alphas'
+    /// product for a rough one (after Filter Glossy), 1 for every other lobe.
+    pub fn transmission_alpha2(&self) -> f32 {
+        let rough = |d: &RoughDielectric| d.roughness.alpha_x * d.roughness.alpha_y;
+        match self {
+            BsdfInstance::Dielectric(_) => 0.0,
+            BsdfInstance::RoughDielectric(d) => rough(d),
+            BsdfInstance::Layered(l) => match &l.base {
+                BaseLobe::Dielectric(_) => 0.0,
+                BaseLobe::RoughDielectric(d) => rough(d),
+                _ => 1.0,
+            },
+            _ => 1.0,
+        }
+    }
+
     /// A glossy layer over a diffuse base evaluated as its two parts, `(diffuse, glossy)` per
     /// steradian (their sum is `eval`), for the corrections Cycles applies to its diffuse
     /// closures alone; `None` for BSDFs that are not such a pair.

@@ -106,7 +106,9 @@ impl PixelAcc {
             Vec3::ZERO
         };
         let alpha = if transparent && n > 0 {
-            self.coverage / n as f32
+            // Film > Transparent Glass's samples may leave [0, 1]; their mean stays in it
+            // but for the noise (Cycles saturates it too).
+            (self.coverage / n as f32).clamp(0.0, 1.0)
         } else {
             1.0
         };

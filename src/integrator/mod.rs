@@ -471,6 +471,19 @@ impl ShadingPoint {
         self.bsdf.is_delta()
     }
 
+    /// Whether the ray this point sampled (record `rec`, its Light Path bits `flags`) keeps a
+    /// camera path's transparent background (Cycles' `LABEL_TRANSMIT_TRANSPARENT`): a
+    /// transmission by a lobe that is not diffuse, whose `alpha_x · alpha_y` is at most
+    /// `threshold` ([`RenderScene::transparent_glass`]).
+    #[inline]
+    pub fn keeps_clear(&self, rec: &BsdfQueryRecord, flags: u32, threshold: f32) -> bool {
+        use crate::shading::globals::ray;
+        if flags & ray::TRANSMISSION == 0 || flags & ray::DIFFUSE != 0 {
+            return false;
+        }
+        rec.measure == bsdf::Measure::Discrete || self.bsdf.transmission_alpha2() <= threshold
+    }
+
     /// `f · |cos θo|` for a world direction `wo`, zero if `wo` would cross the geometric surface
     /// on the wrong side for a reflection (avoids light leaks through shading normals).
     #[inline]
@@ -1042,7 +1055,13 @@ pub fn trace_emitted(
     } else {
         ctx.ray_flags
     };
-    let emitted = scene.emission_at(hit.as_ref(), o, d, ctx.path_at(), flags, ctx.receiver);
+    let emitted = match &hit {
+        Some(its) => scene.emitted(its, o, flags, ctx.path_at(), ctx.receiver),
+        // A transparent-background path (Film > Transparent Glass) sees no world: it adds
+        // to the film's transparency instead (the path integrators count it).
+        None if ctx.clear_path => None,
+        None => scene.background_radiance(d, o, depth, flags),
+    };
     (hit, emitted)
 }
 

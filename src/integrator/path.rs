@@ -192,10 +192,15 @@ impl PathMats {
         ctx.blur = 0.0;
         ctx.walks_subsurface = true;
         ctx.medium = scene.camera_medium;
+        // Film > Transparent Glass: the path starts with a transparent background.
+        let glass = scene.transparent_glass();
+        (ctx.clear_path, ctx.see_through) = (glass.is_some(), 0.0);
+        let glass = glass.unwrap_or(0.0);
         let mut sp = ShadingPoint::unshaded();
         loop {
-            // Inside an interior the segment's length is needed: no shortcut.
-            let last = depth >= end && ctx.medium.is_clear();
+            // Inside an interior the segment's length is needed: no shortcut; nor where the
+            // path may escape to a transparent background (whether it does is counted).
+            let last = depth >= end && ctx.medium.is_clear() && !ctx.clear_path;
             let (hit, mut emitted, mut lights) =
                 trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
             let scattered = through_medium(
@@ -232,11 +237,18 @@ impl PathMats {
                     end = end.min(depth + 1);
                 }
                 ctx.depths = counts.depths(transparent);
+                ctx.clear_path = false;
                 (o, d) = (p, wo);
                 depth += 1;
                 continue;
             }
             let Some(its) = hit else {
+                if ctx.clear_path && depth > 1 {
+                    // Seen through transmission: the world is transparent (Cycles'
+                    // `average(throughput)`); escapes of the camera ray itself are in the
+                    // film's coverage already.
+                    ctx.see_through += throughput.element_sum() / 3.0;
+                }
                 return l;
             };
             // At the path's last vertex a surface that lets the ray through (a volume's
@@ -303,6 +315,9 @@ impl PathMats {
                 min_ray_pdf = min_ray_pdf.min(rec.pdf);
             }
             throughput *= w;
+            if ctx.clear_path {
+                ctx.clear_path = sp.keeps_clear(&rec, ctx.ray_flags, glass);
+            }
             // `sample` left the new ray's Light Path bits in the context.
             if counts.count(ctx.ray_flags, &self.paths) {
                 end = end.min(depth + 1);
@@ -364,10 +379,15 @@ impl PathMis {
         ctx.blur = 0.0;
         ctx.walks_subsurface = true;
         ctx.medium = scene.camera_medium;
+        // Film > Transparent Glass: the path starts with a transparent background.
+        let glass = scene.transparent_glass();
+        (ctx.clear_path, ctx.see_through) = (glass.is_some(), 0.0);
+        let glass = glass.unwrap_or(0.0);
         let mut sp = ShadingPoint::unshaded();
         loop {
-            // Inside an interior the segment's length is needed: no shortcut.
-            let last = depth >= end && ctx.medium.is_clear();
+            // Inside an interior the segment's length is needed: no shortcut; nor where the
+            // path may escape to a transparent background (whether it does is counted).
+            let last = depth >= end && ctx.medium.is_clear() && !ctx.clear_path;
             let (hit, mut emitted, mut lights) = trace_lit(scene, ctx, o, d, depth, last, bsdf_pdf);
             let scattered = through_medium(
                 &self.paths,
@@ -414,11 +434,18 @@ impl PathMis {
                     end = end.min(depth + 1);
                 }
                 ctx.depths = counts.depths(transparent);
+                ctx.clear_path = false;
                 (o, d) = (p, wo);
                 depth += 1;
                 continue;
             }
             let Some(its) = hit else {
+                if ctx.clear_path && depth > 1 {
+                    // Seen through transmission: the world is transparent (Cycles'
+                    // `average(throughput)`); escapes of the camera ray itself are in the
+                    // film's coverage already.
+                    ctx.see_through += throughput.element_sum() / 3.0;
+                }
                 return l;
             };
             // At the path's last vertex a surface that lets the ray through (a volume's
@@ -506,6 +533,9 @@ impl PathMis {
                 min_ray_pdf = min_ray_pdf.min(rec.pdf);
             }
             throughput *= w;
+            if ctx.clear_path {
+                ctx.clear_path = sp.keeps_clear(&rec, ctx.ray_flags, glass);
+            }
             // `sample` left the new ray's Light Path bits in the context.
             if counts.count(ctx.ray_flags, &self.paths) {
                 end = end.min(depth + 1);

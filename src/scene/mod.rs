@@ -864,6 +864,11 @@ pub struct RenderSettings {
     /// Blender's `render.film_transparent`: camera rays that see only the world give alpha 0
     /// (and no colour).
     pub film_transparent: bool,
+    /// Cycles' Film > Transparent Glass (`cycles.film_transparent_glass`), with its roughness
+    /// threshold (`cycles.film_transparent_roughness`): with a transparent film, the world seen
+    /// through transmission no rougher than the threshold (and through transparent surfaces)
+    /// is transparent too. `None`: off.
+    pub film_transparent_glass: Option<f32>,
     /// The world's mist settings (the Mist pass).
     pub mist: Mist,
 }

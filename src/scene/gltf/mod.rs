@@ -564,6 +564,14 @@ impl<'a> Loader<'a> {
             s.film_transparent = member(r, "film_transparent")
                 .and_then(Value::as_bool)
                 .unwrap_or(false);
+            if member(r, "film_transparent_glass").and_then(Value::as_bool) == Some(true) {
+                let t = member(r, "film_transparent_roughness")
+                    .and_then(Value::as_f64)
+                    .map(|v| v as f32)
+                    .filter(|v| v.is_finite())
+                    .unwrap_or(0.1);
+                s.film_transparent_glass = Some(t.clamp(0.0, 1.0));
+            }
             if let Some(m) = member(r, "mist") {
                 let f = |k: &str, d: f32| {
                     member(m, k)
