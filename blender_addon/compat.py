@@ -991,6 +991,17 @@ def motion_blur_position(scene):
     return position
 
 
+def film_transparent_glass(scene):
+    """Cycles' Film > Transparent > Transparent Glass: its roughness threshold
+    (``cycles.film_transparent_roughness``) when ``cycles.film_transparent_glass`` is on, else
+    None. Both live in Cycles' scene settings (``scene.cycles``) from Blender 2.80 through 5.x;
+    without them (Cycles not loaded) the setting is off."""
+    cyc = getattr(scene, "cycles", None)
+    if not bool(getattr(cyc, "film_transparent_glass", False)):
+        return None
+    return float(getattr(cyc, "film_transparent_roughness", 0.1))
+
+
 def rolling_shutter_type(scene):
     """Cycles' rolling shutter type ('NONE', 'TOP'), or None without Cycles' settings."""
     return getattr(getattr(scene, "cycles", None), "rolling_shutter_type", None)

@@ -99,6 +99,15 @@ class TESELA_PT_render(bpy.types.Panel):
         prop(col, "caustics_refractive", text="Refractive")
         col = layout.column(heading="Film")
         col.prop(scene.render, "film_transparent", text="Transparent")
+        cyc = getattr(scene, "cycles", None)
+        if cyc is not None and hasattr(cyc, "film_transparent_glass"):
+            # Cycles' own settings (scene.cycles), which Tesela follows.
+            sub = col.column()
+            sub.active = scene.render.film_transparent
+            sub.prop(cyc, "film_transparent_glass", text="Transparent Glass")
+            sub = sub.column()
+            sub.active = scene.render.film_transparent and cyc.film_transparent_glass
+            sub.prop(cyc, "film_transparent_roughness", text="Roughness Threshold")
         prop(col, "pixel_filter_type")
         prop(col, "filter_width")
         col = layout.column(heading="Performance")

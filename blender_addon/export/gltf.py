@@ -413,8 +413,13 @@ def write_gltf(depsgraph, filepath, *, width, height, camera=None, render_settin
     ext_root = {"TESELA_world": world}
     used_ext.add("TESELA_world")
     if render_settings is not None:
-        ext_root["TESELA_render"] = dict(
-            render_settings, film_transparent=bool(getattr(scene.render, "film_transparent", False)))
+        transparent = bool(getattr(scene.render, "film_transparent", False))
+        ext_root["TESELA_render"] = dict(render_settings, film_transparent=transparent)
+        glass = compat.film_transparent_glass(scene) if transparent else None
+        if glass is not None:
+            # Written only when on: scenes without it keep their bytes.
+            ext_root["TESELA_render"].update(film_transparent_glass=True,
+                                             film_transparent_roughness=glass)
         mist = getattr(scene.world, "mist_settings", None) if scene.world is not None else None
         if mist is not None:
             falloff = {"QUADRATIC": 2.0, "LINEAR": 1.0, "INVERSE_QUADRATIC": 0.5}

@@ -359,6 +359,8 @@ def configure_cycles(scene, width=64, height=64, spp=64, max_bounces=8, seed=0, 
     scene.render.resolution_y = height
     scene.render.resolution_percentage = 100
     scene.render.film_transparent = False
+    scene.cycles.film_transparent_glass = False
+    scene.cycles.film_transparent_roughness = 0.1
     scene.render.use_persistent_data = False
     if threads:
         scene.render.threads_mode = "FIXED"

@@ -242,12 +242,56 @@ CASES = [
 ]
 
 
-def _render_both(tmp_path, monkeypatch, tesela_bin, case):
+# Film > Transparent > Transparent Glass: (id, glass builder, Cycles max bounces, spp,
+# roughness threshold). Each sphere stands on the floor in front of the coloured world: the sky
+# seen through the clear and the slightly rough glass (below the threshold) is transparent, the
+# floor seen through it and the sky in its reflections are not; the rough glass (above the
+# threshold) stays opaque, as without the setting.
+GLASS_CASES = [
+    ("transparent_glass_clear", lambda: glass_film("GLASS", 0.0), 8, 256, 0.1),
+    ("transparent_glass_rough_below", lambda: glass_film("GLASS", 0.05), 8, 256, 0.1),
+    ("transparent_glass_rough_above", lambda: glass_film("GLASS", 0.3), 8, 256, 0.1),
+    ("transparent_glass_principled", lambda: glass_film("PRINCIPLED", 0.0), 8, 256, 0.1),
+]
+
+
+def glass_film(kind, roughness):
+    """A glass sphere (a Glass BSDF, GGX, of ``roughness``, or a Principled BSDF with
+    Transmission 1) on a small grey floor in front of a constant world (0.5, 0.55, 0.6), lit
+    by a sun; the camera sees the sky above the floor's far edge, through the sphere too."""
+    scene = scenes.clear_scene()
+    scenes.add_quad("Floor", [(-1.5, -1.5, 0), (1.5, -1.5, 0), (1.5, 1.5, 0), (-1.5, 1.5, 0)],
+                    scenes.lambert("Grey", (0.6, 0.6, 0.6)))
+    if kind == "PRINCIPLED":
+        mat = scenes.material("Glass", base_color=(1.0, 1.0, 1.0), roughness=roughness,
+                              transmission=1.0, ior=1.45)
+    else:
+        mat, nt, g = scenes.shader_only("Glass", "ShaderNodeBsdfGlass")
+        if hasattr(g, "distribution"):
+            g.distribution = "GGX"
+        g.inputs["Roughness"].default_value = roughness
+        g.inputs["IOR"].default_value = 1.45
+    scenes.add_sphere("Ball", (0.0, 0.0, 0.6), 0.6, mat)
+    scenes.add_sun_light("Sun", (0.3, 0.5, -0.8), 2.0)
+    world, nt, out = _world_nodes(scene)
+    bg = nt.nodes.new("ShaderNodeBackground")
+    bg.inputs["Color"].default_value = (0.5, 0.55, 0.6, 1.0)
+    nt.links.new(bg.outputs[0], out.inputs["Surface"])
+    scenes.add_camera((0.0, -4.0, 1.1), (0.0, 0.0, 0.6), fov=math.radians(40.0))
+    return scene
+
+
+def _render_both(tmp_path, monkeypatch, tesela_bin, case, glass=None):
+    """Cycles' and Tesela's render of ``case``; ``glass``: Film > Transparent Glass on with
+    that roughness threshold."""
     name, build, bounces, spp, transparent = case
     monkeypatch.setenv("TESELA_BINARY", str(tesela_bin))
     scene = build()
     scenes.configure_cycles(scene, SIZE, SIZE, spp, bounces, seed=7)
     scene.render.film_transparent = transparent
+    if glass is not None:
+        scene.cycles.film_transparent_glass = True
+        scene.cycles.film_transparent_roughness = glass
     ref = imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
     scene.render.engine = "TESELA"
     t = scene.tesela
@@ -266,6 +310,20 @@ def _case_id(c):
 def test_world_agrees_with_cycles(addon, tesela_bin, tmp_path, monkeypatch, case):
     name, transparent = case[0], case[4]
     ref, got = _render_both(tmp_path, monkeypatch, tesela_bin, case)
+    _check(name, ref, got, transparent)
+
+
+@pytest.mark.parametrize("case", GLASS_CASES, ids=[_case_id(c) for c in GLASS_CASES])
+def test_transparent_glass_agrees_with_cycles(addon, tesela_bin, tmp_path, monkeypatch, case):
+    """Film > Transparent Glass: colour and alpha as Cycles'."""
+    name, build, bounces, spp, threshold = case
+    ref, got = _render_both(tmp_path, monkeypatch, tesela_bin,
+                            (name, build, bounces, spp, True), glass=threshold)
+    _check(name, ref, got, True)
+
+
+def _check(name, ref, got, transparent):
+    """Colour (and, on a transparent film, alpha) within the module's tolerances."""
     assert ref[..., :3].mean() > 0.01, "the Cycles reference is black: the scene is broken"
     result = imgcompare.compare(got, ref, mean_tol=MEAN_TOL, block_tol=BLOCK_TOL)
     print(f"{name}: {result}")
