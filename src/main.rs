@@ -191,7 +191,8 @@ struct RenderArgs {
     /// setting, whose default is 0: single scattering).
     #[arg(long, value_name = "N")]
     volume_bounces: Option<u32>,
-    /// Most transparent surfaces passed straight through (Cycles' transparent_max_bounces).
+    /// Most transparent surfaces a path passes straight through (Cycles'
+    /// transparent_max_bounces): the next surface ends it; shadow rays get what it has left.
     #[arg(long, default_value_t = 8, value_name = "N")]
     transparent_bounces: u32,
     /// Clamp direct light: a sample's |R|+|G|+|B| above this is scaled down to it (Cycles'

@@ -251,6 +251,12 @@ pub struct Ctx {
     /// with [`Ctx::clear_path`] kept (what the film's coverage loses beyond
     /// [`RenderScene::camera_coverage`]).
     pub see_through: f32,
+    /// Cycles' `transparent_max_bounces` for the current path, set by the integrator (the
+    /// film's coverage and data passes read it after the path: they follow the same camera
+    /// ray).
+    pub transparent_max: u32,
+    /// Transparent surfaces the current path has passed straight through so far.
+    pub transparent: u32,
 }
 
 /// A path vertex's index and the path's bounces of each kind before it: what an emitter's
@@ -297,7 +303,33 @@ impl Ctx {
             time: 0.5,
             clear_path: false,
             see_through: 0.0,
+            transparent_max: MAX_TRANSPARENT,
+            transparent: 0,
         }
+    }
+
+    /// Starts a path that may pass straight through `max` transparent surfaces.
+    #[inline]
+    pub fn start_transparent(&mut self, max: u32) {
+        self.transparent_max = max;
+        self.transparent = 0;
+    }
+
+    /// Transparent surfaces a shadow ray from the current vertex may pass straight through,
+    /// Cycles' `transparent_max_bounces` minus the path's pass-throughs so far: one more
+    /// blocks the light as an opaque surface would.
+    #[inline]
+    pub fn shadow_transparent_left(&self) -> u32 {
+        self.transparent_max.saturating_sub(self.transparent)
+    }
+
+    /// Transparent surfaces the path's current ray may still pass straight through; the
+    /// surface after them ends the path (its emission counts, nothing else), as Cycles ends
+    /// a path whose count reached `transparent_max_bounces` at the next surface (a limit of
+    /// 0 still lets the camera ray through one, as Cycles does).
+    #[inline]
+    pub fn path_transparent_left(&self) -> u32 {
+        self.transparent_max.max(1).saturating_sub(self.transparent)
     }
 
     /// Length left of the camera-ray segment from `o` along the unit `d` before the camera's
@@ -1109,7 +1141,9 @@ impl RenderScene {
                 continue;
             }
             let tr = if occlusion {
-                self.segment_transmittance(ctx, o, d, t, Medium::default(), self.blockers_of(e))
+                let blockers = self.blockers_of(e);
+                let left = ctx.path_transparent_left();
+                self.segment_transmittance(ctx, (o, d, t), Medium::default(), blockers, left)
             } else {
                 Vec3::ONE
             };
@@ -1146,7 +1180,9 @@ impl RenderScene {
             }
             let tr = if occlusion {
                 let blockers = self.blockers_of(e);
-                self.segment_transmittance(ctx, o, d, f32::INFINITY, Medium::default(), blockers)
+                let left = ctx.path_transparent_left();
+                let ray = (o, d, f32::INFINITY);
+                self.segment_transmittance(ctx, ray, Medium::default(), blockers, left)
             } else {
                 Vec3::ONE
             };
@@ -1439,13 +1475,13 @@ impl RenderScene {
     }
 
     /// [`RenderScene::emission_along`] in a scene with transparent surfaces: the first emission
-    /// or background behind up to [`MAX_TRANSPARENT`] transparent surfaces, times their
-    /// transmittance.
+    /// or background behind the transparent surfaces the path may still pass
+    /// ([`Ctx::path_transparent_left`]), times their transmittance.
     fn emission_through(&self, ctx: &mut Ctx, o: Vec3, d: Vec3) -> Emitted {
         let mut tr = Vec3::ONE;
         let mut p = o;
         let mut m = ctx.medium;
-        for _ in 0..=MAX_TRANSPARENT {
+        for _ in 0..=ctx.path_transparent_left() {
             let hit = self.intersect(ctx, p, d);
             if self.absorbs {
                 let t = hit.as_ref().map_or(f32::INFINITY, |h| h.t);
@@ -1525,21 +1561,22 @@ impl RenderScene {
         } else {
             (rec.wi, f32::INFINITY)
         };
-        self.segment_transmittance(ctx, o, d, tmax, ctx.medium, blockers)
+        let left = ctx.shadow_transparent_left();
+        self.segment_transmittance(ctx, (o, d, tmax), ctx.medium, blockers, left)
     }
 
     /// The transmittance of the segment `o + t d`, `t ∈ (0, tmax)`, which starts in medium
     /// `m`: 1 or 0 in opaque scenes, the product of the transparent surfaces' transmittance
     /// and of the interiors' extinction ([`crate::medium`]) otherwise; only objects of the
-    /// blocker sets `blockers` stop it.
+    /// blocker sets `blockers` stop it. More than `passes` transparent surfaces block it as
+    /// an opaque one does (Cycles' transparent bounce limit).
     fn segment_transmittance(
         &self,
         ctx: &mut Ctx,
-        o: Vec3,
-        d: Vec3,
-        tmax: f32,
+        (o, d, tmax): (Vec3, Vec3, f32),
         m: Medium,
         blockers: u64,
+        passes: u32,
     ) -> Vec3 {
         if !self.passes && self.hides & ray::SHADOW == 0 && blockers == LightLinks::ALL {
             ctx.cast(o, d, tmax, RayKind::Any);
@@ -1555,7 +1592,7 @@ impl RenderScene {
         let end = o + d * tmax;
         let (mut o, mut tmax) = (o, tmax);
         let (mut tr, mut m) = (Vec3::ONE, m);
-        for _ in 0..=MAX_TRANSPARENT {
+        for _ in 0..=passes {
             ctx.cast(o, d, tmax, RayKind::Closest);
             let Some(hit) = self.closest_shadowing(ctx, o, d, tmax, blockers) else {
                 return tr * medium::transmittance(m.sigma_t(), tmax);
@@ -1925,7 +1962,8 @@ impl RenderScene {
         // far (Cycles' `average(holdout_weight · throughput)`).
         let (mut tr, mut held) = (Vec3::ONE, 0.0f32);
         let mut p = o;
-        for _ in 0..=MAX_TRANSPARENT {
+        // The camera path passes as many transparent surfaces (the integrator's limit).
+        for _ in 0..=ctx.transparent_max.max(1) {
             let Some(its) = self.trace(ctx, p, d, 1) else {
                 return (1.0 - (tr.x + tr.y + tr.z) / 3.0 - held).clamp(0.0, 1.0);
             };

@@ -308,3 +308,116 @@ fn subsurface_walks_in_path_integrators() {
     );
     assert!(one == four, "thread count changed the image");
 }
+
+/// [`shadow_scene`] with `k` clear-ish panels (Transparent BSDF 0.5) stacked between the floor
+/// and the light (y = 1.0, 1.1, ...), seen from a camera at height `camera_y`.
+fn stacked_panels(k: usize, camera_y: f32) -> Scene {
+    let mut s = shadow_scene(None);
+    s.materials.push(transparent(0.5));
+    let m = s.materials.len() - 1;
+    for i in 0..k {
+        let y = 1.0 + 0.1 * i as f32;
+        s.meshes.push(quad(
+            &format!("panel{i}"),
+            m,
+            Vec3::new(-3.0, y, 3.0),
+            Vec3::new(3.0, y, 3.0),
+            Vec3::new(3.0, y, -3.0),
+            Vec3::new(-3.0, y, -3.0),
+        ));
+    }
+    if let Some(c) = &mut s.camera {
+        c.to_world.w_axis.y = camera_y;
+    }
+    s
+}
+
+/// Cycles' `transparent_max_bounces` = L: a shadow ray from a vertex the path reached after
+/// passing j transparent surfaces passes at most L - j more; one more blocks the light as an
+/// opaque surface does. Under k panels (Transparent 0.5) the floor is lit by 0.5^k of the open
+/// light iff k <= L; seen through the same k panels from above (j = k), by 0.5^2k iff 2k <= L.
+/// Emitter sampling alone is exact pixel by pixel; with BSDF sampling (which also passes
+/// panels, at most L in all when L >= 1) the image's sum is compared.
+#[test]
+fn shadow_rays_pass_at_most_the_transparent_limit() {
+    for integrator in ["direct_ems", "direct_mis", "path_mis"] {
+        let depth = if integrator == "path_mis" { 3 } else { 2 };
+        // A limit of 0 still lets a path ray through one surface (Cycles): emitter sampling only.
+        let first = if integrator == "direct_ems" { 0 } else { 1 };
+        for limit in first..5u32 {
+            let mut o = opts(integrator, 8, 16, depth);
+            o.light_paths.transparent = limit;
+            for camera_y in [0.6, 1.8] {
+                let open = render(stacked_panels(0, camera_y), &o);
+                let lit: f64 = open.iter().map(|p| p[0] as f64).sum();
+                assert!(lit > 1.0, "the floor is lit");
+                for k in 0..6usize {
+                    let passed = if camera_y > 1.0 { k } else { 0 };
+                    let got = render(stacked_panels(k, camera_y), &o);
+                    let n = (k + passed) as u32;
+                    let at =
+                        format!("{integrator}, limit {limit}, {k} panels, camera at {camera_y}");
+                    if n > limit {
+                        assert!(
+                            got.iter().all(|p| p[0] == 0.0),
+                            "{at}: the light is blocked"
+                        );
+                        continue;
+                    }
+                    let expect = 0.5f32.powi(n as i32);
+                    if integrator == "direct_ems" && passed == 0 {
+                        for (a, b) in open.iter().zip(&got) {
+                            let want = expect * a[0];
+                            assert!(
+                                (b[0] - want).abs() <= 1e-5 * a[0].max(1.0),
+                                "{at}: {} vs {want}",
+                                b[0]
+                            );
+                        }
+                    }
+                    let sum: f64 = got.iter().map(|p| p[0] as f64).sum();
+                    let want = expect as f64 * lit;
+                    assert!((sum - want).abs() <= 0.03 * want, "{at}: {sum} vs {want}");
+                }
+            }
+        }
+    }
+}
+
+/// A camera path passes at most `transparent_max_bounces` = L transparent surfaces (one when
+/// L = 0, as in Cycles); the surface after them ends it, its emission still counted: an
+/// emitter behind k clear panels shows iff k <= max(L, 1), in every integrator.
+#[test]
+fn camera_paths_pass_at_most_the_transparent_limit() {
+    for integrator in [
+        "direct_ems",
+        "direct_mats",
+        "direct_mis",
+        "path_mats",
+        "path_mis",
+    ] {
+        for limit in 0..4u32 {
+            for k in 0..5usize {
+                let mut s = through_panel(transparent(1.0));
+                let panel = s.meshes.pop().unwrap();
+                for i in 0..k {
+                    let mut p = panel.clone();
+                    for v in &mut p.positions {
+                        v.z += 0.1 * i as f32;
+                    }
+                    s.meshes.push(p);
+                }
+                let mut o = opts(integrator, 4, 2, 3);
+                o.light_paths.transparent = limit;
+                let want = if k as u32 <= limit.max(1) { 1.0 } else { 0.0 };
+                for p in render(s, &o) {
+                    assert!(
+                        (p[0] - want).abs() < 1e-5,
+                        "{integrator}, limit {limit}, {k} panels: {}",
+                        p[0]
+                    );
+                }
+            }
+        }
+    }
+}

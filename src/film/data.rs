@@ -11,7 +11,6 @@ use super::color::closure_colors;
 use super::pass::{LightClass, Pass, PassSet};
 use crate::accel::offset_origin;
 use crate::camera::RayCamera;
-use crate::integrator::MAX_TRANSPARENT;
 use crate::integrator::light_split::LightSplit;
 use crate::render_scene::{Ctx, RenderScene};
 use crate::scene::Mist;
@@ -76,7 +75,8 @@ impl DataContext<'_> {
         let want_colors = LightClass::ALL
             .into_iter()
             .any(|c| set.contains(c.passes().2));
-        for _ in 0..=MAX_TRANSPARENT {
+        // As many transparent surfaces as the camera path passes (the integrator's limit).
+        for _ in 0..=ctx.transparent_max.max(1) {
             let hit = scene.trace(ctx, p, d, 1);
             if want_emission {
                 let tmax = hit.as_ref().map_or(f32::INFINITY, |h| h.t);

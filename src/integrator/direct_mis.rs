@@ -5,13 +5,16 @@
 
 use super::light_split::{ClassWeights, Sink, SplitsLight};
 use super::path::report;
-use super::{MAX_TRANSPARENT, ShadingPoint, sample_emitter_towards, spawn, trace_lit};
+use super::{ShadingPoint, sample_emitter_towards, spawn, trace_lit};
 use crate::bsdf::Measure;
 use crate::render_scene::{Ctx, RenderScene};
 use glam::Vec3;
 
 pub struct DirectMis {
     pub max_depth: u32,
+    /// Most transparent surfaces a path passes straight through (Cycles'
+    /// `transparent_max_bounces`; shadow rays get what the path has left).
+    pub transparent: u32,
 }
 
 impl SplitsLight for DirectMis {
@@ -28,10 +31,12 @@ impl SplitsLight for DirectMis {
         let mut l = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
-        let mut transparent = 0;
         let mut sp = ShadingPoint::unshaded();
+        ctx.start_transparent(self.transparent);
+        // The vertex the path ends at.
+        let mut end = self.max_depth;
         loop {
-            let last = depth >= self.max_depth;
+            let last = depth >= end;
             let (hit, emitted, lights) = trace_lit(scene, ctx, o, d, depth, last, f32::INFINITY);
             if let Some((_, le, _)) = emitted {
                 l += throughput * le;
@@ -44,7 +49,7 @@ impl SplitsLight for DirectMis {
             let Some(its) = hit else {
                 return l;
             };
-            if depth >= self.max_depth {
+            if last {
                 return l;
             }
             if !sp.shade(scene, ctx, &its, d, depth) {
@@ -52,10 +57,11 @@ impl SplitsLight for DirectMis {
             }
             if sp.passes {
                 // Straight through a transparent closure: not a bounce (Cycles counts these
-                // separately, up to its default of 8).
-                transparent += 1;
-                if transparent > MAX_TRANSPARENT {
-                    return l;
+                // separately, up to `transparent_max_bounces`): once it has passed as many
+                // as it may, it ends at the next surface (whose emission still counts).
+                ctx.transparent += 1;
+                if ctx.path_transparent_left() == 0 {
+                    end = depth;
                 }
                 throughput *= sp.weight;
                 o = spawn(&its, d);

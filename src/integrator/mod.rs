@@ -77,18 +77,26 @@ pub fn by_name_with(
         "direct_ems" => Box::new(direct_ems::DirectEms {
             max_depth,
             follow_delta: true,
+            transparent: paths.transparent,
         }),
         "direct_ems_first_hit" => Box::new(direct_ems::DirectEms {
             max_depth,
             follow_delta: false,
+            transparent: paths.transparent,
         }),
         // Deliberately wrong (not listed in NAMES): for tests that must catch a bias.
         scaled::BIASED_NAME => Box::new(scaled::Scaled {
             inner: by_name("direct_mis", max_depth)?,
             factor: scaled::BIASED_FACTOR,
         }),
-        "direct_mats" => Box::new(direct_mats::DirectMats { max_depth }),
-        "direct_mis" => Box::new(direct_mis::DirectMis { max_depth }),
+        "direct_mats" => Box::new(direct_mats::DirectMats {
+            max_depth,
+            transparent: paths.transparent,
+        }),
+        "direct_mis" => Box::new(direct_mis::DirectMis {
+            max_depth,
+            transparent: paths.transparent,
+        }),
         "path_mats" => Box::new(path::PathMats { max_depth, paths }),
         "path_mis" => Box::new(path::PathMis { max_depth, paths }),
         "normals" => Box::new(debug::Normals),
@@ -116,8 +124,8 @@ pub fn limitations(name: &str, scene: &RenderScene) -> Vec<String> {
     out
 }
 
-/// Most transparent surfaces a path or shadow ray goes straight through (Cycles' default
-/// `transparent_max_bounces`).
+/// Cycles' default `transparent_max_bounces`: the most transparent surfaces a path goes
+/// straight through ([`crate::render_scene::Ctx::start_transparent`]).
 pub const MAX_TRANSPARENT: u32 = 8;
 
 /// The BSDF at a hit in its shading frame, with the local direction towards the ray's origin.

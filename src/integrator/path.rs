@@ -183,7 +183,6 @@ impl PathMats {
         let mut l = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
-        let mut transparent = 0;
         let (mut counts, mut end) = (BounceCount::default(), self.max_depth);
         ctx.depths = Default::default();
         ctx.no_caustics = self.paths.no_caustics();
@@ -196,6 +195,9 @@ impl PathMats {
         let glass = scene.transparent_glass();
         (ctx.clear_path, ctx.see_through) = (glass.is_some(), 0.0);
         let glass = glass.unwrap_or(0.0);
+        // Transparent surfaces passed (kept in the context too, for the shadow rays).
+        let mut transparent = 0;
+        ctx.start_transparent(self.paths.transparent);
         let mut sp = ShadingPoint::unshaded();
         loop {
             // Inside an interior the segment's length is needed: no shortcut; nor where the
@@ -274,12 +276,18 @@ impl PathMats {
             }
             if sp.passes {
                 // Straight through a transparent closure: not a bounce (Cycles counts these
-                // separately, up to its default of 8).
-                transparent += 1;
-                ctx.depths = counts.depths(transparent);
-                if transparent > self.paths.transparent {
+                // separately, up to `transparent_max_bounces`). Once the path has passed as
+                // many as it may, it ends at the next surface (whose emission still counts),
+                // as Cycles ends it; in a medium that surface is shaded, and ends it here.
+                if ctx.path_transparent_left() == 0 {
                     return l;
                 }
+                transparent += 1;
+                ctx.transparent = transparent;
+                if ctx.path_transparent_left() == 0 {
+                    end = depth;
+                }
+                ctx.depths = counts.depths(transparent);
                 throughput *= sp.weight;
                 if scene.absorbs {
                     ctx.medium = medium::after(scene, &its, d, d, ctx.medium);
@@ -366,7 +374,6 @@ impl PathMis {
         let mut l = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut depth = 1;
-        let mut transparent = 0;
         // Density of the BSDF sample that produced the current ray; infinite for camera rays
         // and delta samples (emitter sampling could not have produced them: MIS weight 1).
         let mut bsdf_pdf = f32::INFINITY;
@@ -383,6 +390,9 @@ impl PathMis {
         let glass = scene.transparent_glass();
         (ctx.clear_path, ctx.see_through) = (glass.is_some(), 0.0);
         let glass = glass.unwrap_or(0.0);
+        // Transparent surfaces passed (kept in the context too, for the shadow rays).
+        let mut transparent = 0;
+        ctx.start_transparent(self.paths.transparent);
         let mut sp = ShadingPoint::unshaded();
         loop {
             // Inside an interior the segment's length is needed: no shortcut; nor where the
@@ -471,12 +481,18 @@ impl PathMis {
             }
             if sp.passes {
                 // Straight through a transparent closure: not a bounce (Cycles counts these
-                // separately, up to its default of 8).
-                transparent += 1;
-                ctx.depths = counts.depths(transparent);
-                if transparent > self.paths.transparent {
+                // separately, up to `transparent_max_bounces`). Once the path has passed as
+                // many as it may, it ends at the next surface (whose emission still counts),
+                // as Cycles ends it; in a medium that surface is shaded, and ends it here.
+                if ctx.path_transparent_left() == 0 {
                     return l;
                 }
+                transparent += 1;
+                ctx.transparent = transparent;
+                if ctx.path_transparent_left() == 0 {
+                    end = depth;
+                }
+                ctx.depths = counts.depths(transparent);
                 throughput *= sp.weight;
                 if scene.absorbs {
                     ctx.medium = medium::after(scene, &its, d, d, ctx.medium);
