@@ -1730,3 +1730,104 @@ fn chi2_rejects_hair_samples_of_another_tilt() {
     }));
     assert!(r.is_err(), "a 2° tilt passed unseen");
 }
+
+// ---------------------------------------------------------------------------------------------
+// Beckmann (Blender's Glossy, Glass and Refraction BSDFs offer it): visible normals, and the
+// lobes built on them.
+
+#[test]
+fn beckmann_visible_normals_and_masking() {
+    use tesela::bsdf::microfacet::{Distribution, Roughness};
+    // (alpha_x, alpha_y): isotropic and anisotropic, narrow to very rough.
+    let rough = [(0.08f32, 0.08f32), (0.3, 0.3), (1.0, 1.0), (0.5, 0.1)];
+    let thetas = [0.0, 45.0, 75.0, 89.0];
+    let alpha_case = sidak(SIGNIFICANCE, rough.len() * thetas.len());
+    let mut seed = 1700;
+    for &(ax, ay) in &rough {
+        let r = Distribution {
+            roughness: Roughness::new(ax, ay),
+            beckmann: true,
+        };
+        for &theta in &thetas {
+            let wi = dir_at(theta);
+            let gamma = if ax.min(ay) < 0.2 { 2.0 } else { 1.0 };
+            let grid = DirGrid::new(Vec3::Z, PI / 2.0, gamma, 30, 60);
+            seed += 1;
+            let res = check_directions(
+                &format!("Beckmann visible normals α=({ax}, {ay}) θi={theta}°"),
+                &grid,
+                N / 2,
+                seed,
+                &mut |s| Some(r.sample_visible_normal(wi, s.next_2d())),
+                &|h| r.visible_normal_pdf(wi, h) as f64,
+                alpha_case,
+            );
+            // ∫ G1(wi) (wi·h) D(h) / wi.z dh = 1 holds only with the exact Smith Λ.
+            assert!(
+                (res.integral - 1.0).abs() < 2e-3,
+                "∫D_wi = {}",
+                res.integral
+            );
+        }
+    }
+}
+
+#[test]
+fn beckmann_lobes_sampling() {
+    let tint = Vec3::new(0.9, 0.6, 0.3);
+    let conductors = [
+        ("a=0.2", RoughConductor::new(tint, 0.2).with_beckmann(true)),
+        (
+            "ax=0.6 ay=0.15",
+            RoughConductor::with(0.6, 0.15, ConductorFresnel::Constant(tint)).with_beckmann(true),
+        ),
+    ];
+    let dielectrics = [
+        (
+            "glass 1.5 a=0.3",
+            RoughDielectric::glass(Vec3::ONE, 1.5, 0.3).with_beckmann(true),
+        ),
+        (
+            "refraction 1.45 a=0.5",
+            RoughDielectric::refraction(Vec3::ONE, 1.45, 0.5).with_beckmann(true),
+        ),
+    ];
+    let alpha_case = sidak(SIGNIFICANCE, 2 * 2 + 2 * 3);
+    let mut seed = 1800;
+    for (name, b) in &conductors {
+        for theta in [10.0, 70.0] {
+            let wi = dir_at(theta);
+            seed += 1;
+            let gamma = if b.roughness.alpha_y < 0.2 { 2.0 } else { 1.0 };
+            let r = check_bsdf(
+                &format!("Beckmann conductor {name} θi={theta}°"),
+                b,
+                wi,
+                &DirGrid::new(mirror_dir(wi), PI, gamma, 40, 60),
+                seed,
+                alpha_case,
+            );
+            assert!(r.integral <= 1.0 + 1e-3, "∫pdf = {}", r.integral);
+            assert!((r.integral + r.rest_fraction - 1.0).abs() < 0.01);
+        }
+    }
+    for (name, b) in &dielectrics {
+        for theta in [10.0f64, 70.0, -40.0] {
+            let mut wi = dir_at(theta.abs());
+            if theta < 0.0 {
+                wi.z = -wi.z;
+            }
+            seed += 1;
+            let r = check_bsdf(
+                &format!("Beckmann {name} θi={theta}°"),
+                b,
+                wi,
+                &DirGrid::new(refracted_or_mirror(wi, b.ior), PI, 1.0, 40, 60),
+                seed,
+                alpha_case,
+            );
+            assert!(r.integral <= 1.0 + 1e-3, "∫pdf = {}", r.integral);
+            assert!((r.integral + r.rest_fraction - 1.0).abs() < 0.01);
+        }
+    }
+}

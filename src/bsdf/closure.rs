@@ -102,6 +102,7 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
             roughness,
             anisotropy: a,
             multiscatter,
+            beckmann,
             tint,
             ..
         } => {
@@ -116,7 +117,7 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
                 } else {
                     ConductorFresnel::Constant(*color)
                 };
-                let l = RoughConductor::with(ax, ay, fresnel);
+                let l = RoughConductor::with(ax, ay, fresnel).with_beckmann(*beckmann);
                 let ms = *multiscatter && ax.max(ay) >= DELTA_ALPHA;
                 BsdfInstance::RoughConductor(if ms { l.multiscatter() } else { l }.blurred(blur))
             }
@@ -126,6 +127,7 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
             roughness,
             ior,
             multiscatter,
+            beckmann,
             tint,
         } => {
             let alpha = roughness * roughness;
@@ -135,7 +137,7 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
                 let _ = color;
                 BsdfInstance::Dielectric(Dielectric::new(*ior, Vec3::ONE))
             } else {
-                let l = RoughDielectric::glass(Vec3::ONE, *ior, alpha);
+                let l = RoughDielectric::glass(Vec3::ONE, *ior, alpha).with_beckmann(*beckmann);
                 let ms = *multiscatter && alpha >= DELTA_ALPHA;
                 let l = if ms {
                     l.multiscatter_with_fss(*tint)
@@ -149,11 +151,14 @@ fn build(c: &Closure, u: f32, blur: f32) -> BsdfInstance {
             color,
             roughness,
             ior,
+            beckmann,
         } => {
             let _ = color;
             let alpha = (roughness * roughness).max(DELTA_ALPHA);
             BsdfInstance::RoughDielectric(
-                RoughDielectric::refraction(Vec3::ONE, *ior, alpha).blurred(blur),
+                RoughDielectric::refraction(Vec3::ONE, *ior, alpha)
+                    .with_beckmann(*beckmann)
+                    .blurred(blur),
             )
         }
         ClosureKind::Translucent { color } => BsdfInstance::Translucent(Translucent::new(*color)),
@@ -193,10 +198,17 @@ pub fn from_closure_without_caustics(
         ClosureKind::Refraction { .. } if refr => None,
         ClosureKind::Glass { .. } if refl && refr => None,
         // Cycles keeps the glass's reflection.
-        ClosureKind::Glass { roughness, ior, .. } if refr => {
+        ClosureKind::Glass {
+            roughness,
+            ior,
+            beckmann,
+            ..
+        } if refr => {
             let alpha = roughness * roughness;
             Some(BsdfInstance::RoughDielectric(
-                RoughDielectric::reflection(Vec3::ONE, *ior, alpha, alpha).blurred(blur),
+                RoughDielectric::reflection(Vec3::ONE, *ior, alpha, alpha)
+                    .with_beckmann(*beckmann)
+                    .blurred(blur),
             ))
         }
         ClosureKind::Principled(p) if p.cycles => {
@@ -423,6 +435,7 @@ mod tests {
 
     fn glossy(roughness: f32, anisotropy: f32) -> Closure {
         closure(ClosureKind::Glossy {
+            beckmann: false,
             color: Vec3::ONE,
             roughness,
             anisotropy,
@@ -489,6 +502,7 @@ mod tests {
             other => panic!("{other:?}"),
         }
         let glass = closure(ClosureKind::Glass {
+            beckmann: false,
             color: Vec3::ONE,
             roughness: 0.0,
             ior: 1.5,
@@ -508,6 +522,7 @@ mod tests {
             BsdfInstance::Dielectric(_)
         ));
         let refraction = closure(ClosureKind::Refraction {
+            beckmann: false,
             color: Vec3::ONE,
             roughness: 0.1,
             ior: 1.5,

@@ -150,6 +150,135 @@ pub fn sample_visible_normal_aniso(wi: Vec3, alpha_x: f32, alpha_y: f32, u: Vec2
     Vec3::new(alpha_x * nh.x, alpha_y * nh.y, nh.z.max(1e-7)).normalize()
 }
 
+/// Beckmann normal distribution, anisotropic:
+/// `exp(-(hx²/αx² + hy²/αy²) / hz²) / (π αx αy hz⁴)`.
+// Out of line and cold: GGX lobes, the common case, keep their code as it was.
+#[cold]
+#[inline(never)]
+pub fn beckmann_d(h: Vec3, alpha_x: f32, alpha_y: f32) -> f32 {
+    if h.z <= 0.0 {
+        return 0.0;
+    }
+    let c2 = h.z * h.z;
+    let (x, y) = (h.x / alpha_x, h.y / alpha_y);
+    let e = (x * x + y * y) / c2;
+    (-e).exp() / (PI * alpha_x * alpha_y * c2 * c2)
+}
+
+/// Smith's `Λ(w)` for Beckmann, exactly: with `a = |wz| / √(αx² wx² + αy² wy²)`
+/// (`1 / (α tan θ)` along `w`'s azimuth), `Λ = (e^{-a²} / (a √π) - erfc(a)) / 2`. Either
+/// side of the surface (refraction masks the transmitted direction too).
+#[cold]
+#[inline(never)]
+pub fn beckmann_lambda(w: Vec3, alpha_x: f32, alpha_y: f32) -> f32 {
+    if w.z == 0.0 {
+        return f32::INFINITY;
+    }
+    let (x, y) = (alpha_x * w.x, alpha_y * w.y);
+    let s = ((x * x + y * y) as f64).sqrt();
+    if s <= 0.0 {
+        return 0.0;
+    }
+    let a = w.z.abs() as f64 / s;
+    if a > 6.0 {
+        // Below f32's resolution.
+        return 0.0;
+    }
+    (0.5 * ((-a * a).exp() / (a * std::f64::consts::PI.sqrt()) - libm::erfc(a))).max(0.0) as f32
+}
+
+/// Visible-normal sampling for anisotropic Beckmann (Heitz and d'Eon 2014): stretch `wi` to
+/// the unit-roughness configuration, draw the slopes of the normals it sees, rotate them to
+/// its azimuth and unstretch. Density `G1(wi) max(0, wi·h) D(h) / wi.z` with the exact
+/// [`beckmann_lambda`].
+#[cold]
+#[inline(never)]
+pub fn beckmann_sample_visible_normal(wi: Vec3, alpha_x: f32, alpha_y: f32, u: Vec2) -> Vec3 {
+    let v = Vec3::new(alpha_x * wi.x, alpha_y * wi.y, wi.z).normalize();
+    let sin_t = (v.x * v.x + v.y * v.y).sqrt();
+    let (cos_p, sin_p) = if sin_t > 1e-7 {
+        (v.x / sin_t, v.y / sin_t)
+    } else {
+        (1.0, 0.0)
+    };
+    let (sx, sy) = beckmann_visible_slopes(v.z as f64, sin_t as f64, u);
+    let (rx, ry) = (cos_p * sx - sin_p * sy, sin_p * sx + cos_p * sy);
+    Vec3::new(-rx * alpha_x, -ry * alpha_y, 1.0).normalize()
+}
+
+/// The slopes `(x, y)` of a unit-roughness Beckmann normal seen from `(sin θ, 0, cos θ)`: `y`
+/// is Gaussian (`e^{-y²}/√π`), `x` has density `∝ (cot θ - x) e^{-x²}` below `cot θ`, whose
+/// CDF `cot θ (1 + erf x) / 2 + e^{-x²} / (2√π)` is inverted numerically.
+fn beckmann_visible_slopes(cos_t: f64, sin_t: f64, u: Vec2) -> (f32, f32) {
+    let sqrt_pi = std::f64::consts::PI.sqrt();
+    let (ux, uy) = (
+        (u.x as f64).clamp(1e-9, 1.0 - 1e-9),
+        (u.y as f64).clamp(1e-9, 1.0 - 1e-9),
+    );
+    let y = solve_increasing(
+        |t| 0.5 * (1.0 + libm::erf(t)),
+        |t| (-t * t).exp() / sqrt_pi,
+        uy,
+        -6.0,
+        6.0,
+    );
+    if sin_t < 1e-7 {
+        // Normal incidence: both slopes Gaussian.
+        let x = solve_increasing(
+            |t| 0.5 * (1.0 + libm::erf(t)),
+            |t| (-t * t).exp() / sqrt_pi,
+            ux,
+            -6.0,
+            6.0,
+        );
+        return (x as f32, y as f32);
+    }
+    let cot = cos_t / sin_t;
+    let cdf = |t: f64| cot * 0.5 * (1.0 + libm::erf(t)) + (-t * t).exp() / (2.0 * sqrt_pi);
+    let x = solve_increasing(
+        cdf,
+        |t| (cot - t).max(0.0) * (-t * t).exp() / sqrt_pi,
+        ux * cdf(cot),
+        -6.0,
+        cot.min(6.0),
+    );
+    (x as f32, y as f32)
+}
+
+/// The `t` in `[lo, hi]` where the increasing `f` reaches `target`: Newton steps with the
+/// derivative `df`, kept inside a shrinking bracket (bisection where a step leaves it).
+fn solve_increasing(
+    f: impl Fn(f64) -> f64,
+    df: impl Fn(f64) -> f64,
+    target: f64,
+    mut lo: f64,
+    mut hi: f64,
+) -> f64 {
+    let mut t = 0.0f64.clamp(lo, hi);
+    for _ in 0..60 {
+        let e = f(t) - target;
+        if e.abs() < 1e-12 {
+            break;
+        }
+        if e > 0.0 {
+            hi = t;
+        } else {
+            lo = t;
+        }
+        let d = df(t);
+        let next = if d > 0.0 { t - e / d } else { f64::NAN };
+        t = if next > lo && next < hi {
+            next
+        } else {
+            0.5 * (lo + hi)
+        };
+        if hi - lo < 1e-12 {
+            break;
+        }
+    }
+    t
+}
+
 /// GGX roughness, isotropic or not, with the functions that dispatch on it. Isotropic lobes
 /// call exactly the isotropic functions above (bit-identical to code that uses them directly).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -251,6 +380,92 @@ impl Roughness {
     pub fn sample_reflection(&self, wi: Vec3, u: Vec2) -> Option<(Vec3, f32)> {
         if self.is_isotropic() {
             return sample_reflection(wi, self.alpha_x, u);
+        }
+        let h = self.sample_visible_normal(wi, u);
+        let wo = 2.0 * wi.dot(h) * h - wi;
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let pdf = self.reflection_pdf(wi, wo);
+        (pdf > 0.0 && pdf.is_finite()).then_some((wo, pdf))
+    }
+}
+
+/// A roughness read with the GGX or the Beckmann distribution: the view the lobes query (the
+/// lobes keep the flag beside their [`Roughness`], which stays the size GGX needs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Distribution {
+    pub roughness: Roughness,
+    /// Beckmann (Blender's Glossy, Glass and Refraction BSDFs offer it) instead of GGX.
+    pub beckmann: bool,
+}
+
+impl Distribution {
+    #[inline]
+    pub fn d(&self, h: Vec3) -> f32 {
+        let r = &self.roughness;
+        if self.beckmann {
+            return beckmann_d(h, r.alpha_x, r.alpha_y);
+        }
+        r.d(h)
+    }
+
+    #[inline]
+    pub fn g1(&self, w: Vec3) -> f32 {
+        let r = &self.roughness;
+        if self.beckmann {
+            return 1.0 / (1.0 + beckmann_lambda(w, r.alpha_x, r.alpha_y));
+        }
+        r.g1(w)
+    }
+
+    #[inline]
+    pub fn g2(&self, wi: Vec3, wo: Vec3) -> f32 {
+        let r = &self.roughness;
+        if self.beckmann {
+            let (ax, ay) = (r.alpha_x, r.alpha_y);
+            return 1.0 / (1.0 + beckmann_lambda(wi, ax, ay) + beckmann_lambda(wo, ax, ay));
+        }
+        r.g2(wi, wo)
+    }
+
+    /// A visible normal for `wi` (`wi.z > 0`).
+    #[inline]
+    pub fn sample_visible_normal(&self, wi: Vec3, u: Vec2) -> Vec3 {
+        let r = &self.roughness;
+        if self.beckmann {
+            return beckmann_sample_visible_normal(wi, r.alpha_x, r.alpha_y, u);
+        }
+        r.sample_visible_normal(wi, u)
+    }
+
+    /// Density of the visible normal `h`: `G1(wi) max(0, wi·h) D(h) / wi.z`.
+    #[inline]
+    pub fn visible_normal_pdf(&self, wi: Vec3, h: Vec3) -> f32 {
+        if wi.z <= 0.0 {
+            return 0.0;
+        }
+        self.g1(wi) * wi.dot(h).max(0.0) * self.d(h) / wi.z
+    }
+
+    /// Solid-angle density of the reflected `wo`: `G1(wi) D(h) / (4 wi.z)`.
+    #[inline]
+    pub fn reflection_pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
+        if !self.beckmann {
+            return self.roughness.reflection_pdf(wi, wo);
+        }
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return 0.0;
+        }
+        let h = (wi + wo).normalize();
+        self.g1(wi) * self.d(h) / (4.0 * wi.z)
+    }
+
+    /// A reflected direction `(wo, pdf)`, or `None` below the horizon.
+    #[inline]
+    pub fn sample_reflection(&self, wi: Vec3, u: Vec2) -> Option<(Vec3, f32)> {
+        if !self.beckmann {
+            return self.roughness.sample_reflection(wi, u);
         }
         let h = self.sample_visible_normal(wi, u);
         let wo = 2.0 * wi.dot(h) * h - wi;
@@ -371,6 +586,8 @@ pub struct RoughConductor {
     pub setup_roughness: Roughness,
     pub fresnel: ConductorFresnel,
     pub multiscatter: bool,
+    /// The Beckmann distribution instead of GGX.
+    pub beckmann: bool,
 }
 
 impl RoughConductor {
@@ -382,6 +599,7 @@ impl RoughConductor {
             setup_roughness: roughness,
             fresnel: ConductorFresnel::Schlick(f0),
             multiscatter: false,
+            beckmann: false,
         }
     }
 
@@ -393,6 +611,7 @@ impl RoughConductor {
             setup_roughness: roughness,
             fresnel,
             multiscatter: false,
+            beckmann: false,
         }
     }
 
@@ -408,6 +627,23 @@ impl RoughConductor {
     /// `bsdf_microfacet_blur`; `blur <= 0` changes nothing). The energy compensation stays
     /// that of the roughness the lobe was set up with, as Cycles does not recompute it.
     #[inline]
+    /// The same lobe with the Beckmann distribution (`on`) instead of GGX.
+    pub fn with_beckmann(self, on: bool) -> Self {
+        RoughConductor {
+            beckmann: on,
+            ..self
+        }
+    }
+
+    /// The lobe's roughness with its distribution.
+    #[inline]
+    pub fn distribution(&self) -> Distribution {
+        Distribution {
+            roughness: self.roughness,
+            beckmann: self.beckmann,
+        }
+    }
+
     pub fn blurred(self, blur: f32) -> Self {
         if blur <= 0.0 {
             return self;
@@ -453,7 +689,8 @@ impl Bsdf for RoughConductor {
         if rec.wi.z <= 0.0 {
             return Vec3::ZERO;
         }
-        let Some((wo, pdf)) = self.roughness.sample_reflection(rec.wi, u) else {
+        let a = self.distribution();
+        let Some((wo, pdf)) = a.sample_reflection(rec.wi, u) else {
             return Vec3::ZERO;
         };
         rec.wo = wo;
@@ -462,8 +699,7 @@ impl Bsdf for RoughConductor {
         rec.measure = Measure::SolidAngle;
         let h = (rec.wi + wo).normalize();
         // f cos / pdf = F G2 / G1(wi)
-        let w = self.fresnel.eval(rec.wi.dot(h)) * self.roughness.g2(rec.wi, wo)
-            / self.roughness.g1(rec.wi);
+        let w = self.fresnel.eval(rec.wi.dot(h)) * a.g2(rec.wi, wo) / a.g1(rec.wi);
         if self.multiscatter {
             w * self.energy_factor(rec.wi)
         } else {
@@ -477,8 +713,8 @@ impl Bsdf for RoughConductor {
             return Vec3::ZERO;
         }
         let h = (wi + wo).normalize();
-        let f = self.fresnel.eval(wi.dot(h)) * self.roughness.d(h) * self.roughness.g2(wi, wo)
-            / (4.0 * wi.z * wo.z);
+        let a = self.distribution();
+        let f = self.fresnel.eval(wi.dot(h)) * a.d(h) * a.g2(wi, wo) / (4.0 * wi.z * wo.z);
         if self.multiscatter {
             f * self.energy_factor(wi)
         } else {
@@ -487,7 +723,7 @@ impl Bsdf for RoughConductor {
     }
 
     fn pdf(&self, rec: &BsdfQueryRecord) -> f32 {
-        self.roughness.reflection_pdf(rec.wi, rec.wo)
+        self.distribution().reflection_pdf(rec.wi, rec.wo)
     }
 
     fn is_delta(&self) -> bool {

@@ -26,7 +26,7 @@
 //! mirror tables (Reflection), and `F_ss` chosen as Cycles does (the transmission tint for
 //! glass, the average Fresnel for reflection).
 
-use super::microfacet::Roughness;
+use super::microfacet::{Distribution, Roughness};
 use super::thin_film::ThinFilm;
 use super::{Bsdf, BsdfQueryRecord, Measure, fresnel, tables};
 use glam::{Vec2, Vec3};
@@ -69,6 +69,8 @@ pub struct RoughDielectric {
     /// A thin film on the surface (the Principled BSDF's): its interference replaces the
     /// Fresnel reflectance of reflection and glass modes ([`ThinFilm::principled`]).
     pub thin_film: Option<ThinFilm>,
+    /// The Beckmann distribution instead of GGX.
+    pub beckmann: bool,
 }
 
 /// Relative index within this distance of 1 makes refraction a pass-through (Cycles treats it
@@ -104,6 +106,24 @@ impl RoughDielectric {
             multiscatter_fss: None,
             energy_at: None,
             thin_film: None,
+            beckmann: false,
+        }
+    }
+
+    /// The same lobe with the Beckmann distribution (`on`) instead of GGX.
+    pub fn with_beckmann(self, on: bool) -> Self {
+        RoughDielectric {
+            beckmann: on,
+            ..self
+        }
+    }
+
+    /// The lobe's roughness with its distribution.
+    #[inline]
+    pub fn distribution(&self) -> Distribution {
+        Distribution {
+            roughness: self.roughness,
+            beckmann: self.beckmann,
         }
     }
 
@@ -376,7 +396,7 @@ impl RoughDielectric {
         if wo.z == 0.0 {
             return zero;
         }
-        let a = &self.roughness;
+        let a = self.distribution();
         if wo.z > 0.0 {
             if self.mode == DielectricMode::Refraction {
                 return zero;
@@ -442,7 +462,7 @@ impl Bsdf for RoughDielectric {
         }
         let (flip, eta) = self.side(rec.wi);
         let wi = mirror(rec.wi, flip);
-        let a = &self.roughness;
+        let a = self.distribution();
         let h = a.sample_visible_normal(wi, u);
         let c = wi.dot(h);
         if c <= 0.0 {

@@ -225,6 +225,7 @@ mod tests {
             ),
             (
                 ClosureKind::Glass {
+                    beckmann: false,
                     color,
                     roughness: 0.3,
                     ior: 1.5,
@@ -235,6 +236,7 @@ mod tests {
             ),
             (
                 ClosureKind::Glossy {
+                    beckmann: false,
                     color,
                     roughness: 0.3,
                     anisotropy: 0.0,

@@ -103,6 +103,8 @@ pub enum ClosureKind {
         rotation: f32,
         /// Multiple-scattering GGX (energy compensation), Blender's default distribution.
         multiscatter: bool,
+        /// The Beckmann distribution (else GGX).
+        beckmann: bool,
         /// The node's colour, which is in the closure's weight; the energy compensation takes
         /// it as the average reflectance `F_ss`, as Cycles' constant-Fresnel setup does.
         tint: Vec3,
@@ -113,6 +115,8 @@ pub enum ClosureKind {
         roughness: f32,
         ior: f32,
         multiscatter: bool,
+        /// The Beckmann distribution (else GGX).
+        beckmann: bool,
         /// The node's colour, in the closure's weight: `F_ss` of the energy compensation (Cycles
         /// takes the transmission tint).
         tint: Vec3,
@@ -122,6 +126,8 @@ pub enum ClosureKind {
         color: Vec3,
         roughness: f32,
         ior: f32,
+        /// The Beckmann distribution (else GGX).
+        beckmann: bool,
     },
     /// Lambertian transmission.
     Translucent {

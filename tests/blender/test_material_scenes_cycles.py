@@ -252,6 +252,17 @@ def glass_tinted_ball():
     _sphere_stage(mat)
 
 
+def beckmann_ball(kind, **inputs):
+    """A ball of a Glossy or Glass BSDF with the Beckmann distribution (its longer-tailed
+    highlight than GGX's)."""
+    def build():
+        mat, nt, out = node_material("Beckmann" + kind)
+        n = node(nt, kind, {"distribution": "BECKMANN"}, **inputs)
+        surface(nt, out, n.outputs[0])
+        _sphere_stage(mat)
+    return build
+
+
 def projected_image(projection, interpolation="Linear", coords="Object", blend=0.3):
     """A checker image on a ball through the Image Texture's projection (box with a blend,
     sphere or tube) from Object or Generated coordinates, into a Diffuse BSDF; Cubic reads a
@@ -1253,6 +1264,12 @@ CASES = [
     pytest.param(("normal_map_glass_grazing_view", normal_map_glass, 2, 128, 512),
                  marks=pytest.mark.xfail(reason=GLASS_NORMAL_MAP_REASON, strict=False)),
     ("glass_tinted_ball", glass_tinted_ball, 6, 128, 512),
+    ("beckmann_glossy_ball", beckmann_ball("ShaderNodeBsdfGlossy", Color=(0.9, 0.6, 0.3, 1.0),
+                                           Roughness=0.35), 2, 256, 1024),
+    ("beckmann_anisotropic_ball", beckmann_ball("ShaderNodeBsdfGlossy", Roughness=0.5,
+                                                Anisotropy=0.6), 2, 256, 1024),
+    ("beckmann_glass_ball", beckmann_ball("ShaderNodeBsdfGlass", Roughness=0.3, IOR=1.45),
+     6, 256, 1024),
     ("normal_map_grazing_sun_lambert", lambda: normal_map(specular=0.0), 0, 128, 512),
     # Mapped normals up to 63 degrees off under a sun 15 degrees high: Cycles' bump shadowing
     # of the diffuse part, the raised normal of the specular part, and diffuse shading from

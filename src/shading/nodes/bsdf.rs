@@ -124,6 +124,8 @@ pub enum ClosureParams {
         normal: Option<Slot>,
         tangent: Option<Slot>,
         multiscatter: bool,
+        /// The Beckmann distribution (else GGX).
+        beckmann: bool,
     },
     Glass {
         color: Slot,
@@ -132,6 +134,8 @@ pub enum ClosureParams {
         normal: Option<Slot>,
         refraction_only: bool,
         multiscatter: bool,
+        /// The Beckmann distribution (else GGX).
+        beckmann: bool,
     },
     Translucent {
         color: Slot,
@@ -440,6 +444,7 @@ impl ClosureOp {
                 normal: n,
                 tangent: t,
                 multiscatter,
+                beckmann,
             } => push(
                 out,
                 col(*color) * w,
@@ -451,6 +456,7 @@ impl ClosureOp {
                     anisotropy: s.f(*anisotropy).clamp(-1.0, 1.0),
                     rotation: s.f(*rotation),
                     multiscatter: *multiscatter,
+                    beckmann: *beckmann,
                     tint: col(*color).max(Vec3::ZERO),
                 },
             ),
@@ -461,6 +467,7 @@ impl ClosureOp {
                 normal: n,
                 refraction_only,
                 multiscatter,
+                beckmann,
             } => {
                 let (color, roughness, ior) = (
                     col(*color),
@@ -474,6 +481,7 @@ impl ClosureOp {
                         color: Vec3::ONE,
                         roughness,
                         ior,
+                        beckmann: *beckmann,
                     }
                 } else {
                     ClosureKind::Glass {
@@ -481,6 +489,7 @@ impl ClosureOp {
                         roughness,
                         ior,
                         multiscatter: *multiscatter,
+                        beckmann: *beckmann,
                         tint: color.max(Vec3::ZERO),
                     }
                 };
@@ -867,7 +876,7 @@ fn world_normal(n: Vec3, _g: &ShaderGlobals) -> Vec3 {
 fn warn_microfacet_distribution(cx: &mut NodeCx) {
     match cx.prop_str("distribution").unwrap_or("MULTI_GGX") {
         "GGX" | "MULTI_GGX" | "SHARP" => {}
-        "BECKMANN" => cx.warn("the Beckmann distribution renders as GGX"),
+        "BECKMANN" => {}
         "ASHIKHMIN_SHIRLEY" => cx.warn("the Ashikhmin-Shirley distribution renders as GGX"),
         d => cx.warn(&format!("the {d} distribution renders as GGX")),
     }
@@ -1105,6 +1114,7 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                 normal: normal(cx, "Normal")?,
                 tangent: normal(cx, "Tangent")?,
                 multiscatter: cx.prop_str("distribution").unwrap_or("MULTI_GGX") == "MULTI_GGX",
+                beckmann: cx.prop_str("distribution") == Some("BECKMANN"),
             }
         }
         "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction" => {
@@ -1116,6 +1126,7 @@ pub fn compile_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, Com
                 normal: normal(cx, "Normal")?,
                 refraction_only: kind == "ShaderNodeBsdfRefraction",
                 multiscatter: cx.prop_str("distribution").unwrap_or("MULTI_GGX") == "MULTI_GGX",
+                beckmann: cx.prop_str("distribution") == Some("BECKMANN"),
             }
         }
         "ShaderNodeBsdfToon" => ClosureParams::Toon {
