@@ -11,7 +11,7 @@
 //! (Blender's poly curves); `materials`: the object's material slots (glTF material indices,
 //! null for an empty slot); `material_index`: SCALAR per curve, its slot (optional: 0).
 
-use glam::{Mat4, Vec3};
+use glam::Mat4;
 use json::accessor::Type;
 use serde_json::Value;
 
@@ -121,9 +121,7 @@ impl<'a> Loader<'a> {
         let extras = member(node, "extras");
         let mut object = self.object_info(ni, extras, world);
         object.strands = true;
-        let to_object = Some(world.inverse())
-            .filter(|m| m.is_finite())
-            .unwrap_or(Mat4::IDENTITY);
+        let to_object = super::mesh::object_from_world(world);
         let segments = offsets
             .windows(2)
             .map(|w| (w[1] - w[0]).saturating_sub(1) as usize)
@@ -152,10 +150,6 @@ impl<'a> Loader<'a> {
                 continue;
             }
             let material = self.material(*gltf_material, false)?;
-            let (lo, hi) = tubes.positions.iter().fold(
-                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-                |(l, h), p| (l.min(*p), h.max(*p)),
-            );
             let local = LocalPrim {
                 positions: tubes.positions,
                 normals: tubes.normals,
@@ -176,14 +170,10 @@ impl<'a> Loader<'a> {
                 material,
                 world,
                 to_object,
-                texspace: Some(super::mesh::auto_texspace(lo, hi)),
+                texspace: None,
                 object: object.clone(),
             };
-            let first = self.scene.meshes.len();
-            self.push_world_mesh(&local, placed)?;
-            let origins = &mut self.origins.mesh_node;
-            origins.resize(first, None);
-            origins.resize(first + 1, Some(ni));
+            self.push_built_mesh(ni, &local, placed)?;
         }
         Ok(())
     }

@@ -198,6 +198,14 @@ pub(crate) struct PlacedPrim {
     pub object: ObjectInfo,
 }
 
+/// World → object for a node placed by `world`: its inverse, or the identity where `world` is
+/// singular.
+pub(crate) fn object_from_world(world: Mat4) -> Mat4 {
+    Some(world.inverse())
+        .filter(|m| m.is_finite())
+        .unwrap_or(Mat4::IDENTITY)
+}
+
 fn floats<const N: usize>(v: Option<&Value>) -> Option<[f32; N]> {
     let a = v?.as_array().filter(|a| a.len() == N)?;
     let mut out = [0.0; N];
@@ -334,9 +342,7 @@ impl<'a> Loader<'a> {
         } else {
             self.object_info(ni, extras, world)
         };
-        let to_object = Some(world.inverse())
-            .filter(|m| m.is_finite())
-            .unwrap_or(Mat4::IDENTITY);
+        let to_object = object_from_world(world);
         let single = mesh.primitives.len() == 1;
         for (pi, local, material) in prims {
             let name = if single {
@@ -356,6 +362,30 @@ impl<'a> Loader<'a> {
             self.push_world_mesh(&local, placed)?;
         }
         Ok((first..self.scene.meshes.len(), kept))
+    }
+
+    /// Adds a mesh the loader built for node `ni` from one of its extensions (strand tubes,
+    /// point spheres) as [`Self::push_world_mesh`] does, its Generated coordinates spanning
+    /// its bounds unless `placed` gives a texture space, and records the node it came from.
+    pub(crate) fn push_built_mesh(
+        &mut self,
+        ni: usize,
+        local: &LocalPrim,
+        mut placed: PlacedPrim,
+    ) -> Result<(), LoadError> {
+        if placed.texspace.is_none() {
+            let (lo, hi) = local.positions.iter().fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(l, h), p| (l.min(*p), h.max(*p)),
+            );
+            placed.texspace = Some(auto_texspace(lo, hi));
+        }
+        let first = self.scene.meshes.len();
+        self.push_world_mesh(local, placed)?;
+        let origins = &mut self.origins.mesh_node;
+        origins.resize(first, None);
+        origins.resize(first + 1, Some(ni));
+        Ok(())
     }
 
     /// Adds primitive `local` to the scene as a world-space mesh placed as `placed` says,

@@ -9,7 +9,7 @@
 //! shades every point with it; absent or null: the default surface); `attributes`: VEC4 float
 //! accessors, one value per point, that the Attribute node reads by name.
 
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec4};
 use json::accessor::Type;
 use serde_json::Value;
 
@@ -108,19 +108,22 @@ impl<'a> Loader<'a> {
                 "{tag}: {bad} points have a non-finite position or radius, or a negative radius; they are left out"
             ));
         }
+        // Points of radius 0 are invisible in Cycles too: left out without a word.
+        let kept: Vec<u32> = (0..n as u32)
+            .filter(|&i| {
+                let (c, r) = (centers[i as usize], radii[i as usize]);
+                c.is_finite() && r.is_finite() && r > 0.0
+            })
+            .collect();
         let random: Vec<f32> = (0..n as u32).map(|i| hash_uint2_to_float(i, 0)).collect();
-        let which: Vec<u32> = (0..n as u32).collect();
         let level = level_within(n, TRIANGLE_BUDGET);
-        let s = spheres(&centers, &radii, &random, &which, level);
+        let s = spheres(&centers, &radii, &random, &kept, level);
         if s.tris.is_empty() {
             return Ok(());
         }
-        // Each attribute's value on every vertex of its point's sphere: spheres are built in
-        // point order with the same vertex count, skipping the points left out.
+        // Each attribute's value on every vertex of its point's sphere (the spheres are those
+        // of `kept`, in its order, each of the same vertex count).
         let verts = sphere_vertices(level);
-        let kept: Vec<usize> = (0..n)
-            .filter(|&i| centers[i].is_finite() && radii[i].is_finite() && radii[i] > 0.0)
-            .collect();
         let mut colors = vec![
             (POINT_LAYER.to_string(), s.info),
             (POINT_RANDOM_LAYER.to_string(), s.random),
@@ -128,20 +131,12 @@ impl<'a> Loader<'a> {
         for (name, values) in attributes {
             let expanded = kept
                 .iter()
-                .flat_map(|&i| std::iter::repeat_n(values[i], verts))
+                .flat_map(|&i| std::iter::repeat_n(values[i as usize], verts))
                 .collect();
             colors.push((name, expanded));
         }
         let material = self.material(material, false)?;
-        let (lo, hi) = s.positions.iter().fold(
-            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-            |(l, h), p| (l.min(*p), h.max(*p)),
-        );
-        let extras = member(node, "extras");
-        let object = self.object_info(ni, extras, world);
-        let to_object = Some(world.inverse())
-            .filter(|m| m.is_finite())
-            .unwrap_or(Mat4::IDENTITY);
+        let object = self.object_info(ni, member(node, "extras"), world);
         let name = member(node, "name")
             .and_then(Value::as_str)
             .unwrap_or("points")
@@ -161,16 +156,11 @@ impl<'a> Loader<'a> {
             name,
             material,
             world,
-            to_object,
-            texspace: Some(super::mesh::auto_texspace(lo, hi)),
+            to_object: super::mesh::object_from_world(world),
+            texspace: None,
             object,
         };
-        let first = self.scene.meshes.len();
-        self.push_world_mesh(&local, placed)?;
-        let origins = &mut self.origins.mesh_node;
-        origins.resize(first, None);
-        origins.resize(first + 1, Some(ni));
-        Ok(())
+        self.push_built_mesh(ni, &local, placed)
     }
 }
 
