@@ -681,6 +681,17 @@ impl ClosureOp {
     }
 }
 
+/// Warns where a volume node's phase function is not Henyey-Greenstein, the one Tesela
+/// renders (with the node's anisotropy).
+fn warn_phase(cx: &mut NodeCx) {
+    match cx.prop_str("phase").unwrap_or("HENYEY_GREENSTEIN") {
+        "HENYEY_GREENSTEIN" => {}
+        p => cx.warn(&format!(
+            "the {p} phase function renders as Henyey-Greenstein of the node's anisotropy"
+        )),
+    }
+}
+
 /// A shader node reached from the material output's Volume: Volume Absorption, Volume Scatter
 /// (Henyey–Greenstein), Principled Volume and Emission (radiance per metre) make the
 /// homogeneous medium of the interior; surface shaders are reported and add nothing there, as
@@ -692,12 +703,7 @@ fn compile_volume_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, 
             density: cx.float("Density", 1.0)?,
         },
         "ShaderNodeVolumeScatter" => {
-            match cx.prop_str("phase").unwrap_or("HENYEY_GREENSTEIN") {
-                "HENYEY_GREENSTEIN" => {}
-                p => cx.warn(&format!(
-                    "the {p} phase function renders as Henyey-Greenstein of the node's anisotropy"
-                )),
-            }
+            warn_phase(cx);
             ClosureParams::Scatter {
                 color: cx.color("Color", Vec3::splat(0.8))?,
                 density: cx.float("Density", 1.0)?,
@@ -705,12 +711,7 @@ fn compile_volume_closure(kind: &str, cx: &mut NodeCx, w: Slot) -> Result<bool, 
             }
         }
         "ShaderNodeVolumeCoefficients" => {
-            match cx.prop_str("phase").unwrap_or("HENYEY_GREENSTEIN") {
-                "HENYEY_GREENSTEIN" => {}
-                p => cx.warn(&format!(
-                    "the {p} phase function renders as Henyey-Greenstein of the node's anisotropy"
-                )),
-            }
+            warn_phase(cx);
             ClosureParams::Coefficients {
                 absorption: cx.vector("Absorption Coefficients", Vec3::ONE)?,
                 scatter: cx.vector("Scatter Coefficients", Vec3::ONE)?,
