@@ -13,6 +13,15 @@ use tesela::scene::builtin::quad;
 use tesela::scene::{Camera, Material, Projection, Scene};
 use tesela::shading::Graph;
 
+/// The integrators that render light (not the debug views).
+const LIGHT_INTEGRATORS: [&str; 5] = [
+    "direct_ems",
+    "direct_mats",
+    "direct_mis",
+    "path_mats",
+    "path_mis",
+];
+
 fn opts(integrator: &str, size: u32, spp: u32, max_depth: u32) -> RenderOptions {
     RenderOptions {
         width: size,
@@ -169,13 +178,7 @@ fn through_panel(panel: Material) -> Scene {
 
 #[test]
 fn camera_rays_pass_through_transparent_closures() {
-    for integrator in [
-        "direct_ems",
-        "direct_mats",
-        "direct_mis",
-        "path_mats",
-        "path_mis",
-    ] {
+    for integrator in LIGHT_INTEGRATORS {
         let px = render(through_panel(transparent(0.4)), &opts(integrator, 8, 4, 3));
         for p in &px {
             assert!((p[0] - 0.4).abs() < 1e-5, "{integrator}: {}", p[0]);
@@ -389,13 +392,7 @@ fn shadow_rays_pass_at_most_the_transparent_limit() {
 /// emitter behind k clear panels shows iff k <= max(L, 1), in every integrator.
 #[test]
 fn camera_paths_pass_at_most_the_transparent_limit() {
-    for integrator in [
-        "direct_ems",
-        "direct_mats",
-        "direct_mis",
-        "path_mats",
-        "path_mis",
-    ] {
+    for integrator in LIGHT_INTEGRATORS {
         for limit in 0..4u32 {
             for k in 0..5usize {
                 let mut s = through_panel(transparent(1.0));

@@ -65,11 +65,15 @@ def scatter():
     return info
 
 
-def assert_agrees_with_cycles(scene, label, spp, tmp_path):
+def assert_agrees_with_cycles(scene, label, spp, tmp_path, before_tesela=None):
     """Cycles and Tesela (through the add-on, direct lighting with MIS) render `scene` at
-    `spp`; the images must agree (means within 2%, 8x8-block p95 within 5%)."""
+    `spp`; the images must agree (means within 2%, 8x8-block p95 within 5%). `before_tesela`,
+    if given, changes the scene between the two renders (for a Cycles reference built another
+    way)."""
     scenes.configure_cycles(scene, SIZE, SIZE, spp, 0, seed=7)
     ref = imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
+    if before_tesela is not None:
+        before_tesela()
     scene.render.engine = "TESELA"
     t = scene.tesela
     scenes.tesela_like_cycles(t)

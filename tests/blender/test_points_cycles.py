@@ -11,10 +11,8 @@ from pathlib import Path
 import bpy
 import pytest
 
-import imgcompare
 import scenes
-from test_addon import result_pixels
-from test_instances_cycles import SIZE, assert_agrees_with_cycles
+from test_instances_cycles import assert_agrees_with_cycles
 
 REPO = Path(__file__).resolve().parent.parent.parent
 if str(REPO) not in sys.path:
@@ -187,20 +185,13 @@ def test_point_attribute_agrees_with_instanced_spheres(addon, tesela_bin, tmp_pa
     ng.links.new(iop.outputs["Instances"], out.inputs["Geometry"])
     attr = next(x for x in mat.node_tree.nodes if x.bl_idname == "ShaderNodeAttribute")
     attr.attribute_type = "INSTANCER"
-    scene = info.scene
-    scenes.configure_cycles(scene, SIZE, SIZE, 256, 0, seed=7)
-    ref = imgcompare.read_exr(scenes.render_cycles(tmp_path / "cycles.exr"))
-    ng.links.new(store.outputs["Geometry"], out.inputs["Geometry"])
-    attr.attribute_type = "GEOMETRY"
-    scene.render.engine = "TESELA"
-    t = scene.tesela
-    scenes.tesela_like_cycles(t)
-    t.integrator, t.samples, t.max_depth, t.seed = "direct_mis", 256, 2, 1
-    assert bpy.ops.render.render() == {"FINISHED"}
-    got = result_pixels(tmp_path)
-    result = imgcompare.compare(got, ref, mean_tol=0.02, block_tol=0.05)
-    print(f"points point_attribute: {result}")
-    assert result.ok, f"point attribute: Tesela (add-on) vs Cycles' instanced spheres: {result}"
+
+    def points_themselves():
+        ng.links.new(store.outputs["Geometry"], out.inputs["Geometry"])
+        attr.attribute_type = "GEOMETRY"
+
+    assert_agrees_with_cycles(info.scene, "points point_attribute (Cycles: instanced spheres)",
+                              256, tmp_path, before_tesela=points_themselves)
 
 
 def test_points_export_as_tesela_points(addon, tmp_path):
